@@ -1,0 +1,36 @@
+/* cli.h -- the command-line front end: option parsing shared by every
+ * command, and the commands themselves (list, render, reference, compare).
+ * Exit status: 0 success, 1 runtime error, 2 usage error. */
+#ifndef SL_CLI_H
+#define SL_CLI_H
+#include "lab/report.h"
+
+enum { EXIT_OK = 0, EXIT_RUNTIME = 1, EXIT_USAGE = 2 };
+
+#define CLI_MAX_ASSIGN 64
+
+typedef struct CliOptions {
+    const char *scene;
+    const char *technique;
+    const char *params[CLI_MAX_ASSIGN];
+    int num_params;
+    const char *overrides[CLI_MAX_ASSIGN];
+    int num_overrides;
+    const char *out_dir;
+    int threads, repeat, light;
+    ReferenceParams ref;
+    const char *cache_dir; /* NULL: default */
+    bool no_cache, no_png, json, help;
+} CliOptions;
+
+/* Parse argv after the command name; usage errors are reported in err.
+ * `needs_scene` requires one positional SCENE argument. */
+bool cli_parse(int argc, char **argv, bool needs_scene, CliOptions *o, Error *err);
+void cli_apply_threads(const CliOptions *o);
+
+int cmd_list(int argc, char **argv);
+int cmd_render(int argc, char **argv);
+int cmd_reference(int argc, char **argv);
+int cmd_compare(int argc, char **argv);
+
+#endif

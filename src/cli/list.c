@@ -1,0 +1,83 @@
+/* list.c -- `shadowlab list`: every technique in the registry with its
+ * parameters (type, default, range, unit, doc), as text or JSON. */
+#include <string.h>
+#include "cli/cli.h"
+#include "core/json.h"
+
+static void print_text(void)
+{
+    for (int i = 0; i < tech_count(); i++) {
+        const Technique *t = tech_at(i);
+        printf("%s  [%s; %s]\n  %s\n", t->name, t->family, t->source, t->summary);
+        printf("  resources:");
+        for (const char *const *r = t->resources; *r; r++) printf(" %s", *r);
+        printf("\n");
+        for (int k = 0; k < t->num_params; k++) {
+            const ParamDesc *p = &t->params[k];
+            char def[64], range[256];
+            tech_param_format(p, p->def, def, sizeof def);
+            tech_param_range(p, range, sizeof range);
+            printf("  -p %s=%s  (%s %s%s%s)\n      %s\n", p->name, def, param_type_name(p->type), range,
+                   p->unit[0] ? ", " : "", p->unit, p->doc);
+        }
+        printf("\n");
+    }
+}
+
+static void print_json(void)
+{
+    JsonWriter w;
+    json_init(&w, stdout);
+    json_array_begin(&w, NULL);
+    for (int i = 0; i < tech_count(); i++) {
+        const Technique *t = tech_at(i);
+        json_object_begin(&w, NULL);
+        json_string(&w, "name", t->name);
+        json_string(&w, "family", t->family);
+        json_string(&w, "source", t->source);
+        json_string(&w, "summary", t->summary);
+        json_bool(&w, "rgb", t->rgb);
+        json_array_begin(&w, "resources");
+        for (const char *const *r = t->resources; *r; r++) json_string(&w, NULL, *r);
+        json_array_end(&w);
+        json_array_begin(&w, "params");
+        for (int k = 0; k < t->num_params; k++) {
+            const ParamDesc *p = &t->params[k];
+            json_object_begin(&w, NULL);
+            json_string(&w, "name", p->name);
+            json_string(&w, "type", param_type_name(p->type));
+            json_number(&w, "default", p->def);
+            json_number(&w, "min", p->min);
+            json_number(&w, "max", p->max);
+            json_string(&w, "unit", p->unit);
+            json_string(&w, "doc", p->doc);
+            if (p->type == PARAM_ENUM) {
+                json_array_begin(&w, "choices");
+                for (int c = 0; p->choices[c]; c++) json_string(&w, NULL, p->choices[c]);
+                json_array_end(&w);
+            }
+            json_object_end(&w);
+        }
+        json_array_end(&w);
+        json_object_end(&w);
+    }
+    json_array_end(&w);
+    json_finish(&w);
+}
+
+int cmd_list(int argc, char **argv)
+{
+    CliOptions o;
+    Error err;
+    if (!cli_parse(argc, argv, false, &o, &err)) {
+        fprintf(stderr, "shadowlab list: %s\n", err.msg);
+        return EXIT_USAGE;
+    }
+    if (o.help) {
+        printf("usage: shadowlab list [--json]\n  every technique with its parameters: type, default, range, unit, doc\n");
+        return EXIT_OK;
+    }
+    if (o.json) print_json();
+    else print_text();
+    return EXIT_OK;
+}

@@ -1,0 +1,134 @@
+/* lab.c -- scene + resource manager, and the render stage: view samples and
+ * classes from the manager, the technique's prepare, then `repeat` timed
+ * evaluations in parallel over rows. Samples that are not lit candidates get
+ * the reference's convention (0, or 1 on non-receivers) after evaluation. */
+#include "lab/lab.h"
+#include <stdlib.h>
+#include <string.h>
+#include "core/timer.h"
+
+struct Lab {
+    Scene scene;
+    ResourceManager *rm;
+    double load_s;
+};
+
+Lab *lab_open(const char *scene_path, const char *const *overrides, int num_overrides, Error *err)
+{
+    Lab *lab = calloc(1, sizeof *lab);
+    if (!lab) { error_set(err, "out of memory"); return NULL; }
+    double t0 = timer_now_s();
+    if (!scene_load(scene_path, overrides, num_overrides, &lab->scene, err)) {
+        free(lab);
+        return NULL;
+    }
+    lab->load_s = timer_now_s() - t0;
+    lab->rm = rm_create();
+    if (!lab->rm) {
+        lab_close(lab);
+        error_set(err, "out of memory");
+        return NULL;
+    }
+    return lab;
+}
+
+void lab_close(Lab *lab)
+{
+    if (!lab) return;
+    rm_destroy(lab->rm);
+    scene_free(&lab->scene);
+    free(lab);
+}
+
+const Scene *lab_scene(const Lab *lab) { return &lab->scene; }
+ResourceManager *lab_resources(Lab *lab) { return lab->rm; }
+double lab_scene_load_seconds(const Lab *lab) { return lab->load_s; }
+
+bool lab_light_index(const Lab *lab, int number, int *index, Error *err)
+{
+    if (number < 1 || number > lab->scene.num_lights)
+        return error_set(err, "--light %d outside [1, %d] (the scene's lights)", number, lab->scene.num_lights);
+    *index = number - 1;
+    return true;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* One timed evaluation of every row, in parallel. */
+static double evaluate_all(const Technique *t, const void *state, const TechContext *ctx, Image *out)
+{
+    const ViewSamples *vs = ctx->vs;
+    double t0 = timer_now_s();
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int y = 0; y < vs->height; y++) {
+        int begin = y * vs->width;
+        t->evaluate(state, ctx, begin, begin + vs->width, out->data + (size_t)begin * (size_t)ctx->channels);
+    }
+    return timer_now_s() - t0;
+}
+
+/* Convention for samples outside the evaluated class; broadcast a 1-channel
+ * technique to the reference's 3 channels. */
+static void finish_image(Image *img, int tech_channels, const uint8_t *cls)
+{
+    int nc = img->channels;
+    long count = (long)img->width * img->height;
+    for (long s = count - 1; s >= 0; s--) {
+        float *px = img->data + s * nc;
+        float v = tech_channels == 1 ? img->data[s * tech_channels] : px[0];
+        if (cls[s] != SAMPLE_LIT_CANDIDATE) v = cls[s] == SAMPLE_NOT_RECEIVER ? 1.0f : 0.0f;
+        if (tech_channels == 1 || cls[s] != SAMPLE_LIT_CANDIDATE)
+            for (int c = 0; c < nc; c++) px[c] = v;
+    }
+}
+
+static bool run_evaluations(const RenderRequest *req, const void *state, const TechContext *ctx, RenderResult *out)
+{
+    double *times = malloc(sizeof(double) * (size_t)req->repeat);
+    if (!times) return false;
+    for (int i = 0; i < req->repeat; i++) times[i] = evaluate_all(req->tech, state, ctx, &out->visibility);
+    qsort(times, (size_t)req->repeat, sizeof(double), cmp_double);
+    out->eval_min_s = times[0];
+    out->eval_median_s = req->repeat % 2 ? times[req->repeat / 2]
+                                         : 0.5 * (times[req->repeat / 2 - 1] + times[req->repeat / 2]);
+    free(times);
+    return true;
+}
+
+bool lab_render(Lab *lab, const RenderRequest *req, RenderResult *out, Error *err)
+{
+    memset(out, 0, sizeof *out);
+    const Scene *sc = &lab->scene;
+    if (req->repeat < 1 || req->repeat > 10000) return error_set(err, "--repeat %d outside [1, 10000]", req->repeat);
+    double t0 = timer_now_s();
+    const ViewSamples *vs = res_view_samples(lab->rm, sc, err);
+    const uint8_t *cls = vs ? res_classes(lab->rm, sc, req->light_index, err) : NULL;
+    if (!cls) return false;
+    out->view_s = timer_now_s() - t0;
+    int ref_channels = reference_channels(sc, req->light_index, MEASURE_VISIBILITY);
+    TechContext ctx = {sc, req->light_index, &sc->lights[req->light_index], vs, cls, lab->rm, req->params,
+                       req->tech->rgb ? ref_channels : 1};
+    if (!image_init(&out->visibility, vs->width, vs->height, ref_channels, err)) return false;
+    void *state = NULL;
+    t0 = timer_now_s();
+    if (!req->tech->prepare(&ctx, &state, err)) {
+        image_free(&out->visibility);
+        return error_prefix(err, "%s: ", req->tech->name);
+    }
+    out->prepare_s = timer_now_s() - t0;
+    out->repeat = req->repeat;
+    bool ok = run_evaluations(req, state, &ctx, out);
+    if (req->tech->release) req->tech->release(state);
+    if (!ok) {
+        image_free(&out->visibility);
+        return error_set(err, "out of memory");
+    }
+    finish_image(&out->visibility, ctx.channels, cls);
+    return true;
+}
+
+void render_result_free(RenderResult *r) { image_free(&r->visibility); }

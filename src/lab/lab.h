@@ -1,0 +1,40 @@
+/* lab.h -- one comparison's pipeline behind an opaque handle (Embree-style:
+ * open, use, close). A Lab holds a loaded scene and a resource manager;
+ * renders, references and metrics reuse whatever the manager already holds,
+ * so a sweep in one process builds each resource once. The CLI and the Lua
+ * bindings are thin layers over this. */
+#ifndef SL_LAB_H
+#define SL_LAB_H
+#include "metrics/metrics.h"
+#include "resources/standard.h"
+#include "techniques/registry.h"
+
+typedef struct Lab Lab;
+
+Lab *lab_open(const char *scene_path, const char *const *overrides, int num_overrides, Error *err);
+void lab_close(Lab *lab);
+const Scene *lab_scene(const Lab *lab);
+ResourceManager *lab_resources(Lab *lab);
+double lab_scene_load_seconds(const Lab *lab);
+/* Check a 1-based light number against the scene; returns the 0-based index. */
+bool lab_light_index(const Lab *lab, int light_number, int *index, Error *err);
+
+typedef struct RenderRequest {
+    const Technique *tech;
+    const double *params; /* tech->num_params values */
+    int light_index;
+    int repeat;           /* evaluations timed; >= 1 */
+} RenderRequest;
+
+typedef struct RenderResult {
+    Image visibility;      /* per view sample, 1 or 3 channels */
+    double view_s;         /* view samples + classes (0 when reused) */
+    double prepare_s;      /* the technique's resource acquisition and set-up */
+    double eval_median_s, eval_min_s;
+    int repeat;
+} RenderResult;
+
+bool lab_render(Lab *lab, const RenderRequest *req, RenderResult *out, Error *err);
+void render_result_free(RenderResult *r);
+
+#endif

@@ -1,0 +1,236 @@
+/* record.c -- the JSON record of a run and the printed metrics table: scene
+ * and its hash, technique and every parameter value, per-stage timings,
+ * resources built and reused, metrics, reference samples and noise, thread
+ * count, machine and git commit, so a figure can be regenerated from records
+ * alone. */
+#include <math.h>
+#include <string.h>
+#include <sys/utsname.h>
+#include "core/fsutil.h"
+#include "core/hash.h"
+#include "core/json.h"
+#include "lab/report.h"
+#include "version.h"
+
+static void cpu_model(char *out, size_t n)
+{
+    snprintf(out, n, "unknown");
+    FILE *fp = fopen("/proc/cpuinfo", "r");
+    if (!fp) return;
+    char line[512];
+    while (fgets(line, sizeof line, fp)) {
+        char *colon = strchr(line, ':');
+        if (strncmp(line, "model name", 10) == 0 && colon) {
+            snprintf(out, n, "%s", colon + 2);
+            out[strcspn(out, "\n")] = '\0';
+            break;
+        }
+    }
+    fclose(fp);
+}
+
+static void write_machine(JsonWriter *w, int threads)
+{
+    struct utsname u;
+    char cpu[256];
+    cpu_model(cpu, sizeof cpu);
+    json_object_begin(w, "machine");
+    if (uname(&u) == 0) {
+        json_string(w, "host", u.nodename);
+        json_string(w, "system", u.sysname);
+        json_string(w, "release", u.release);
+        json_string(w, "arch", u.machine);
+    }
+    json_string(w, "cpu", cpu);
+    json_int(w, "threads", threads);
+    json_string(w, "commit", SHADOWLAB_COMMIT);
+    json_object_end(w);
+}
+
+static void write_scene(JsonWriter *w, const RunReport *r)
+{
+    const Scene *sc = lab_scene(r->lab);
+    char hex[17];
+    json_object_begin(w, "scene");
+    json_string(w, "name", sc->name);
+    json_string(w, "path", sc->path);
+    hash_hex(sc->hash, hex);
+    json_string(w, "hash", hex);
+    json_int(w, "triangles", sc->num_triangles);
+    json_int(w, "width", sc->camera.width);
+    json_int(w, "height", sc->camera.height);
+    json_int(w, "supersample", sc->camera.supersample);
+    json_int(w, "light", r->light_index + 1);
+    json_string(w, "light_type", light_kind_name(sc->lights[r->light_index].kind));
+    json_array_begin(w, "models");
+    for (int i = 0; i < sc->num_objects; i++) json_string(w, NULL, sc->objects[i].source);
+    json_array_end(w);
+    json_object_end(w);
+}
+
+static void write_technique(JsonWriter *w, const RunReport *r)
+{
+    json_object_begin(w, "technique");
+    json_string(w, "name", r->tech->name);
+    json_string(w, "family", r->tech->family);
+    json_string(w, "source", r->tech->source);
+    json_object_begin(w, "params");
+    for (int i = 0; i < r->tech->num_params; i++) {
+        const ParamDesc *p = &r->tech->params[i];
+        if (p->type == PARAM_ENUM) json_string(w, p->name, p->choices[(int)r->params[i]]);
+        else if (p->type == PARAM_BOOL) json_bool(w, p->name, r->params[i] != 0.0);
+        else json_number(w, p->name, r->params[i]);
+    }
+    json_object_end(w);
+    json_object_end(w);
+}
+
+static void write_reference(JsonWriter *w, const RunReport *r)
+{
+    const ReferenceParams *p = &r->ref->params;
+    char hex[17];
+    json_object_begin(w, "reference");
+    json_string(w, "measure", measure_name(p->measure));
+    json_int(w, "samples", p->samples);
+    json_string(w, "pattern", sampling_pattern_name(p->pattern));
+    json_int(w, "seed", p->seed);
+    json_int(w, "rays", r->ref->rays);
+    hash_hex(r->ref_info->key, hex);
+    json_string(w, "key", hex);
+    json_string(w, "origin", ref_origin_name(r->ref_info->origin));
+    json_string(w, "cache_path", r->ref_info->cache_path);
+    if (r->ref_info->cache_note[0]) json_string(w, "cache_note", r->ref_info->cache_note);
+    json_number(w, "seconds", r->ref_info->seconds);
+    json_number(w, "rays_per_second", r->ref_info->rays_per_second);
+    if (r->metrics) json_number(w, "noise_rms", r->metrics->noise_rms);
+    json_object_end(w);
+}
+
+static void write_stats(JsonWriter *w, const char *key, const ErrorStats *s)
+{
+    json_object_begin(w, key);
+    json_int(w, "count", s->count);
+    json_number(w, "mae", s->mae);
+    json_number(w, "rmse", s->rmse);
+    json_number(w, "max_abs", s->max_abs);
+    json_number(w, "mean_signed", s->mean_signed);
+    json_number(w, "leak_mean", s->leak_mean);
+    json_number(w, "dark_mean", s->dark_mean);
+    json_number(w, "misclassified", s->misclassified);
+    json_object_end(w);
+}
+
+static void write_metrics(JsonWriter *w, const RunReport *r)
+{
+    const Metrics *m = r->metrics;
+    json_object_begin(w, "metrics");
+    json_object_begin(w, "samples");
+    for (int c = 0; c < SAMPLE_CLASS_COUNT; c++) json_int(w, sample_class_name((SampleClass)c), m->class_count[c]);
+    json_object_end(w);
+    for (int g = 0; g < REGION_COUNT; g++) write_stats(w, region_name((Region)g), &m->region[g]);
+    json_int(w, "false_shadow", m->false_shadow);
+    json_int(w, "false_lit", m->false_lit);
+    json_number(w, "noise_rms", m->noise_rms);
+    json_number(w, "rmse_debiased", m->rmse_debiased);
+    json_bool(w, "resolved", m->resolved);
+    json_int(w, "nonfinite", m->nonfinite);
+    json_int(w, "out_of_range", m->out_of_range);
+    json_number(w, "error_png_scale", r->error_scale);
+    json_object_end(w);
+}
+
+static void write_timings(JsonWriter *w, const RunReport *r)
+{
+    json_object_begin(w, "timings_s");
+    json_number(w, "scene_load", lab_scene_load_seconds(r->lab));
+    if (r->render) {
+        json_number(w, "view_samples", r->render->view_s);
+        json_number(w, "prepare", r->render->prepare_s);
+        json_number(w, "evaluate_median", r->render->eval_median_s);
+        json_number(w, "evaluate_min", r->render->eval_min_s);
+        json_int(w, "repeat", r->render->repeat);
+    }
+    if (r->ref) json_number(w, "reference", r->ref_info->seconds);
+    if (r->metrics) json_number(w, "metrics", r->metrics_s);
+    json_number(w, "output", r->output_s);
+    json_object_end(w);
+}
+
+static void write_resources(JsonWriter *w, const RunReport *r)
+{
+    const ResourceManager *rm = lab_resources(r->lab);
+    char hex[17];
+    json_array_begin(w, "resources");
+    for (int i = 0; i < rm_log_count(rm); i++) {
+        const ResourceEvent *ev = rm_log_event(rm, i);
+        json_object_begin(w, NULL);
+        json_string(w, "kind", ev->kind);
+        json_string(w, "desc", ev->desc);
+        hash_hex(ev->key, hex);
+        json_string(w, "key", hex);
+        json_string(w, "action", ev->built ? "built" : "reused");
+        json_number(w, "build_s", ev->build_s);
+        json_int(w, "bytes", (long long)ev->bytes);
+        json_object_end(w);
+    }
+    json_array_end(w);
+}
+
+bool report_write_record(const RunReport *r, const char *path, Error *err)
+{
+    AtomicFile af;
+    if (!atomic_open(&af, path, err)) return false;
+    JsonWriter w;
+    json_init(&w, af.fp);
+    json_object_begin(&w, NULL);
+    json_string(&w, "shadowlab_record", "1");
+    json_string(&w, "command", r->command);
+    write_scene(&w, r);
+    if (r->tech) write_technique(&w, r);
+    if (r->ref) write_reference(&w, r);
+    if (r->metrics) write_metrics(&w, r);
+    write_timings(&w, r);
+    write_resources(&w, r);
+    write_machine(&w, r->threads);
+    json_object_end(&w);
+    json_finish(&w);
+    return atomic_commit(&af, err);
+}
+
+/* ---- the table for people ---------------------------------------------- */
+
+void report_print(const RunReport *r, FILE *fp)
+{
+    const Scene *sc = lab_scene(r->lab);
+    fprintf(fp, "%s on %s (light %d: %s, %d triangles)\n", r->tech ? r->tech->name : "reference", sc->name,
+            r->light_index + 1, light_kind_name(sc->lights[r->light_index].kind), sc->num_triangles);
+    if (r->ref)
+        fprintf(fp, "reference: %s, %d %s samples, %.3g s (%s), %.3g Mrays/s\n", measure_name(r->ref->params.measure),
+                r->ref->params.samples, sampling_pattern_name(r->ref->params.pattern), r->ref_info->seconds,
+                ref_origin_name(r->ref_info->origin), r->ref_info->rays_per_second * 1e-6);
+    if (r->render)
+        fprintf(fp, "technique: prepare %.3g s, evaluate %.3g s (median of %d, min %.3g s)\n", r->render->prepare_s,
+                r->render->eval_median_s, r->render->repeat, r->render->eval_min_s);
+    if (r->metrics) {
+        const Metrics *m = r->metrics;
+        fprintf(fp, "%-9s %9s %9s %9s %9s %9s %9s %9s %7s\n", "region", "samples", "MAE", "RMSE", "max|e|", "signed",
+                "leak", "dark", ">0.5");
+        for (int g = 0; g < REGION_COUNT; g++) {
+            const ErrorStats *s = &m->region[g];
+            fprintf(fp, "%-9s %9ld %9.5f %9.5f %9.5f %+9.5f %9.5f %9.5f %7.4f\n", region_name((Region)g), s->count,
+                    s->mae, s->rmse, s->max_abs, s->mean_signed, s->leak_mean, s->dark_mean, s->misclassified);
+        }
+        fprintf(fp, "reference noise rms %.5f; RMSE net of noise %.5f%s\n", m->noise_rms, m->rmse_debiased,
+                m->resolved ? "" : "  (below 2x the reference's noise: not resolved)");
+        fprintf(fp, "false shadow (acne) %ld, false lit (leaks) %ld, non-finite %ld, outside [0,1] %ld\n",
+                m->false_shadow, m->false_lit, m->nonfinite, m->out_of_range);
+        fprintf(fp, "error PNG scale: blue -%g (too dark) .. white 0 .. red +%g (leaking)\n", r->error_scale,
+                r->error_scale);
+    }
+    const ResourceManager *rm = lab_resources(r->lab);
+    for (int i = 0; i < rm_log_count(rm); i++) {
+        const ResourceEvent *ev = rm_log_event(rm, i);
+        fprintf(fp, "resource %-6s %-14s %-40s %8.3f s %10.1f KiB\n", ev->built ? "built" : "reused", ev->kind,
+                ev->desc, ev->build_s, (double)ev->bytes / 1024.0);
+    }
+}

@@ -1,0 +1,40 @@
+/* metrics.h -- error of a visibility image against the reference, over view
+ * samples that face the light (class SAMPLE_LIT_CANDIDATE; background,
+ * back-facing, outside-the-light and non-receiver samples are counted apart,
+ * never as shadow errors). Error e = estimate - reference: e > 0 is light
+ * leaking, e < 0 over-darkening. Regions follow the reference: umbra V <= 0.01,
+ * penumbra 0.01 < V < 0.99, lit V >= 0.99. RGB images are scored per channel,
+ * averaged (the max over channels for max_abs). */
+#ifndef SL_METRICS_H
+#define SL_METRICS_H
+#include "rt/reference.h"
+
+typedef enum Region { REGION_ALL, REGION_PENUMBRA, REGION_UMBRA, REGION_LIT, REGION_COUNT } Region;
+const char *region_name(Region r);
+
+typedef struct ErrorStats {
+    long count;            /* samples in the region */
+    double mae, rmse, max_abs, mean_signed;
+    double leak_mean;      /* mean of max(e, 0): light leaking */
+    double dark_mean;      /* mean of max(-e, 0): over-darkening; leak + dark = mae */
+    double misclassified;  /* fraction with |e| > 0.5 (hard misclassification) */
+} ErrorStats;
+
+typedef struct Metrics {
+    long class_count[SAMPLE_CLASS_COUNT];
+    ErrorStats region[REGION_COUNT];
+    long false_shadow;     /* reference lit (> 0.5), estimate shadowed (< 0.5): acne */
+    long false_lit;        /* reference shadowed (< 0.5), estimate lit (> 0.5): leaks, peter panning */
+    double noise_rms;      /* sqrt(mean of the reference's squared standard errors) */
+    double rmse_debiased;  /* sqrt(max(0, rmse^2 - noise_rms^2)): RMSE net of reference noise */
+    bool resolved;         /* rmse > 2 noise_rms: the error is above the reference's noise */
+    long nonfinite;        /* NaN or Inf estimates (counted as error 1) */
+    long out_of_range;     /* estimates outside [0, 1] */
+} Metrics;
+
+/* `signed_error` (optional) receives e per sample and channel; 0 outside the
+ * evaluated class. est and ref->value must have the same shape. */
+bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls, Metrics *m, Image *signed_error,
+                     Error *err);
+
+#endif

@@ -1,0 +1,54 @@
+/* resources.h -- the resource manager: values with keys (architecture.md).
+ * A resource (an Embree BVH, view samples, a depth map at a resolution and
+ * projection, a SAT, ...) is identified by a 64-bit key hashed from exactly
+ * the inputs it depends on. rm_acquire builds it on first request, times it,
+ * counts its bytes, and hands the same object to every later request with the
+ * same key. Every acquisition is logged, so a run's record says what was
+ * built and what was reused: that is how a scene's unneeded work is left out,
+ * and how a sweep over a kernel size proves it built its depth map once. */
+#ifndef SL_RESOURCES_H
+#define SL_RESOURCES_H
+#include <stddef.h>
+#include <stdint.h>
+#include "core/error.h"
+
+/* What a kind of resource is and how to measure and free one. */
+typedef struct ResourceKind {
+    const char *name;                  /* e.g. "embree_bvh" */
+    size_t (*bytes)(const void *res);
+    void (*destroy)(void *res);
+} ResourceKind;
+
+/* Builds a resource from the caller's arguments; NULL + err on failure. */
+typedef void *(*ResourceBuildFn)(const void *args, Error *err);
+
+/* One line of a run's resource log. */
+typedef struct ResourceEvent {
+    const char *kind;
+    char desc[160];   /* human-readable key, e.g. "casters of scene 3fa2..." */
+    uint64_t key;
+    bool built;       /* false: reused */
+    double build_s;   /* time of the build that made it (also shown on reuse) */
+    size_t bytes;
+} ResourceEvent;
+
+typedef struct ResourceManager ResourceManager;
+
+ResourceManager *rm_create(void);
+void rm_destroy(ResourceManager *rm);
+
+/* Find or build the resource (kind, key). `desc` describes the key for the
+ * log. Thread-compatible, not thread-safe: acquire from one thread. */
+void *rm_acquire(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc,
+                 ResourceBuildFn build, const void *args, Error *err);
+
+/* The log since the last rm_log_reset (one run's worth). */
+int rm_log_count(const ResourceManager *rm);
+const ResourceEvent *rm_log_event(const ResourceManager *rm, int i);
+void rm_log_reset(ResourceManager *rm);
+
+/* Totals over everything the manager holds. */
+size_t rm_bytes(const ResourceManager *rm);
+int rm_count(const ResourceManager *rm);
+
+#endif

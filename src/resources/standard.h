@@ -1,0 +1,37 @@
+/* standard.h -- the engine's own resources, each keyed by exactly what it
+ * depends on: Embree BVHs (all objects, or casters only; one and the same
+ * when every object casts), view samples (geometry + camera), per-light
+ * sample classes, and references (also cached on disk, refcache.h). */
+#ifndef SL_STANDARD_RESOURCES_H
+#define SL_STANDARD_RESOURCES_H
+#include "resources/resources.h"
+#include "rt/reference.h"
+
+const RtScene *res_bvh(ResourceManager *rm, const Scene *scene, RtGeometrySet set, Error *err);
+const ViewSamples *res_view_samples(ResourceManager *rm, const Scene *scene, Error *err);
+const uint8_t *res_classes(ResourceManager *rm, const Scene *scene, int light_index, Error *err);
+
+/* Where a reference came from. */
+typedef enum RefOrigin { REF_COMPUTED, REF_CACHE_HIT, REF_CACHE_CORRUPT_RECOMPUTED, REF_REUSED } RefOrigin;
+const char *ref_origin_name(RefOrigin o);
+
+typedef struct RefRequest {
+    int light_index;
+    ReferenceParams params;
+    const char *cache_dir; /* NULL: no disk cache */
+} RefRequest;
+
+typedef struct RefInfo {
+    RefOrigin origin;
+    uint64_t key;
+    char cache_path[1024];
+    char cache_note[512];   /* why a cache entry was rejected */
+    double seconds;         /* compute or load time */
+    double rays_per_second; /* of the computation that made it (0 when loaded) */
+} RefInfo;
+
+const Reference *res_reference(ResourceManager *rm, const Scene *scene, const RefRequest *req, RefInfo *info,
+                               Error *err);
+uint64_t reference_key(const Scene *scene, const RefRequest *req);
+
+#endif

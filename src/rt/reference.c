@@ -1,0 +1,211 @@
+/* reference.c -- Embree ground truth (see reference.h). Light samples come
+ * from core/sampling (one stream per view sample) mapped onto the light by
+ * scene/light; occlusion rays are traced sixteen at a time with
+ * rtcOccluded16 across all cores. Origins are lifted off the surface by
+ * rt_ray_offset along the geometric normal. */
+#include "rt/reference.h"
+#include <math.h>
+#include <string.h>
+#include "core/progress.h"
+
+#define PACKET 16
+#define INV_PI 0.31830988618379067f
+
+static const char *const measure_names[] = {"visibility", "irradiance"};
+
+const char *measure_name(Measure m) { return measure_names[m]; }
+
+bool measure_parse(const char *name, Measure *m, Error *err)
+{
+    for (int i = 0; i < 2; i++) {
+        if (strcmp(name, measure_names[i]) == 0) {
+            *m = (Measure)i;
+            return true;
+        }
+    }
+    return error_set(err, "--measure '%s' is not one of: visibility, irradiance", name);
+}
+
+bool reference_params_check(const ReferenceParams *p, Error *err)
+{
+    if (p->samples < 1 || p->samples > REFERENCE_MAX_SAMPLES)
+        return error_set(err, "--samples %d outside [1, %d]", p->samples, REFERENCE_MAX_SAMPLES);
+    return sampling_check_count(p->pattern, p->samples, err);
+}
+
+int reference_channels(const Scene *scene, int light_index, Measure m)
+{
+    return (m == MEASURE_IRRADIANCE || scene->lights[light_index].kind == LIGHT_TEXTURED_RECT) ? 3 : 1;
+}
+
+/* Running sums of one view sample's estimator, per colour channel. */
+typedef struct Accum {
+    double w[3], wv[3], w2[3]; /* visibility: weights, weighted hits, squared weights */
+    double c[3], c2[3];        /* irradiance: contributions and their squares */
+    int n;
+} Accum;
+
+typedef struct Batch {
+    LightSample ls[PACKET];
+    _Alignas(64) struct RTCRay16 ray;
+    _Alignas(64) int valid[PACKET];
+} Batch;
+
+static void fill_batch(Batch *b, const Light *l, vec3 org, vec3 p, uint32_t stream, int first, int count,
+                       const ReferenceParams *prm)
+{
+    for (int k = 0; k < PACKET; k++) {
+        int i = first + k;
+        b->valid[k] = i < count ? -1 : 0;
+        if (i >= count) continue;
+        float u, v;
+        sample_2d(prm->pattern, stream, i, count, &u, &v);
+        LightSample *s = &b->ls[k];
+        *s = light_sample(l, p, u, v);
+        b->ray.org_x[k] = org.x; b->ray.org_y[k] = org.y; b->ray.org_z[k] = org.z;
+        b->ray.dir_x[k] = s->dir_world.x; b->ray.dir_y[k] = s->dir_world.y; b->ray.dir_z[k] = s->dir_world.z;
+        b->ray.tnear[k] = 0.0f;
+        b->ray.tfar[k] = isinf(s->dist) ? INFINITY : s->dist * (1.0f - 1e-5f); /* open segment (course Eq. 1.1) */
+        b->ray.time[k] = 0.0f;
+        b->ray.mask[k] = 0xFFFFFFFFu;
+        b->ray.id[k] = (unsigned)k;
+        b->ray.flags[k] = 0;
+    }
+}
+
+static void accumulate(Accum *a, const Batch *b, vec3 n_shading, vec3 albedo)
+{
+    for (int k = 0; k < PACKET; k++) {
+        if (!b->valid[k]) continue;
+        const LightSample *s = &b->ls[k];
+        float vis = b->ray.tfar[k] == -INFINITY ? 0.0f : 1.0f; /* Embree marks occluded rays with tfar = -inf */
+        float cos_p = fmaxf(0.0f, v3_dot(n_shading, s->dir_world));
+        const float w[3] = {s->vis_weight.x, s->vis_weight.y, s->vis_weight.z};
+        const float e[3] = {s->irradiance.x * albedo.x, s->irradiance.y * albedo.y, s->irradiance.z * albedo.z};
+        for (int c = 0; c < 3; c++) {
+            a->w[c] += w[c];
+            a->wv[c] += w[c] * vis;
+            a->w2[c] += (double)w[c] * w[c];
+            double contrib = e[c] * cos_p * vis * INV_PI;
+            a->c[c] += contrib;
+            a->c2[c] += contrib * contrib;
+        }
+        a->n++;
+    }
+}
+
+/* Visibility with a Laplace-smoothed binomial standard error, p~ = (k+1)/(n+2)
+ * in weighted form, so an all-lit or all-blocked sample still reports the
+ * uncertainty of n draws; n_eff = (sum w)^2 / sum w^2 for weighted samples. */
+static void finish_visibility(const Accum *a, float *value, float *se, int nc)
+{
+    for (int c = 0; c < nc; c++) {
+        if (a->w[c] <= 0.0) { value[c] = 1.0f; se[c] = 0.0f; continue; } /* a black light texel set: nothing to block */
+        double mean_w = a->w[c] / a->n;
+        double p = a->wv[c] / a->w[c];
+        double p_s = (a->wv[c] + mean_w) / (a->w[c] + 2.0 * mean_w);
+        double n_eff = a->w[c] * a->w[c] / a->w2[c];
+        value[c] = (float)p;
+        se[c] = (float)sqrt(p_s * (1.0 - p_s) / n_eff);
+    }
+}
+
+static void finish_irradiance(const Accum *a, float *value, float *se)
+{
+    for (int c = 0; c < 3; c++) {
+        double mean = a->c[c] / a->n;
+        double var = a->n > 1 ? fmax(0.0, (a->c2[c] / a->n - mean * mean) * a->n / (a->n - 1)) : 0.0;
+        value[c] = (float)mean;
+        se[c] = (float)sqrt(var / a->n);
+    }
+}
+
+typedef struct RefJob {
+    RTCScene rtc;
+    const Scene *scene;
+    const Light *light;
+    const ViewSamples *vs;
+    const ReferenceParams *p;
+    int count; /* samples per view sample actually traced */
+    float extent;
+    Reference *out;
+} RefJob;
+
+static void trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx, Batch *b)
+{
+    vec3 p = j->vs->p_world[s], ng = j->vs->n_geom_world[s];
+    vec3 org = v3_madd(p, ng, rt_ray_offset(j->extent, p));
+    uint32_t stream = sampling_stream(j->p->seed, (uint32_t)s);
+    Accum a = {0};
+    for (int first = 0; first < j->count; first += PACKET) {
+        fill_batch(b, j->light, org, p, stream, first, j->count, j->p);
+        rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
+        accumulate(&a, b, j->vs->n_shading_world[s], j->scene->objects[j->vs->object[s]].albedo);
+    }
+    int nc = j->out->value.channels;
+    float *v = j->out->value.data + (size_t)s * nc, *se = j->out->std_error.data + (size_t)s * nc;
+    if (j->p->measure == MEASURE_IRRADIANCE) finish_irradiance(&a, v, se);
+    else finish_visibility(&a, v, se, nc);
+}
+
+/* Value of samples that are not traced: unlit (0) unless on a non-receiver,
+ * which receives no shadow (visibility 1). */
+static void fill_untraced(const RefJob *j, int s, uint8_t cls)
+{
+    int nc = j->out->value.channels;
+    float v = (cls == SAMPLE_NOT_RECEIVER && j->p->measure == MEASURE_VISIBILITY) ? 1.0f : 0.0f;
+    for (int c = 0; c < nc; c++) {
+        j->out->value.data[(size_t)s * nc + c] = v;
+        j->out->std_error.data[(size_t)s * nc + c] = 0.0f;
+    }
+}
+
+static bool traced(const RefJob *j, uint8_t cls)
+{
+    if (j->p->measure == MEASURE_IRRADIANCE) return cls == SAMPLE_LIT_CANDIDATE || cls == SAMPLE_NOT_RECEIVER;
+    return cls == SAMPLE_LIT_CANDIDATE;
+}
+
+bool reference_compute(const RtScene *casters, const Scene *scene, int light_index, const ViewSamples *vs,
+                       const uint8_t *cls, const ReferenceParams *p, Reference *out, Error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!reference_params_check(p, err)) return false;
+    int nc = reference_channels(scene, light_index, p->measure);
+    if (!image_init(&out->value, vs->width, vs->height, nc, err) ||
+        !image_init(&out->std_error, vs->width, vs->height, nc, err)) {
+        reference_free(out);
+        return false;
+    }
+    out->params = *p;
+    const Light *l = &scene->lights[light_index];
+    RefJob j = {rt_scene_handle(casters), scene, l, vs, p, light_is_delta(l) ? 1 : p->samples,
+                scene_extent(scene), out};
+    Progress prog;
+    progress_begin(&prog, "reference", vs->height);
+    long long rays = 0;
+#pragma omp parallel reduction(+ : rays)
+    {
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        Batch b;
+#pragma omp for schedule(dynamic, 1)
+        for (int y = 0; y < vs->height; y++) {
+            for (int s = y * vs->width; s < (y + 1) * vs->width; s++) {
+                if (!traced(&j, cls[s])) { fill_untraced(&j, s, cls[s]); continue; }
+                trace_sample(&j, s, &ctx, &b);
+                rays += j.count;
+            }
+            progress_add(&prog, 1);
+        }
+    }
+    progress_end(&prog);
+    out->rays = rays;
+    return true;
+}
+
+void reference_free(Reference *ref)
+{
+    image_free(&ref->value);
+    image_free(&ref->std_error);
+}

@@ -1,0 +1,40 @@
+/* reference.h -- the ground truth: for every view sample, the visible
+ * fraction of the light (course Eq. 1.4; seed 000's s = |D_c ∩ D| / |D| for
+ * sphere lights), RGB-weighted by the emission image for textured lights, or
+ * with MEASURE_IRRADIANCE the Lambertian direct illumination of course
+ * Eq. 1.3, L_o = rho/pi * integral L_e G V dA. Each sample carries its
+ * standard error so no technique's error is read below the reference's noise. */
+#ifndef SL_REFERENCE_H
+#define SL_REFERENCE_H
+#include "core/sampling.h"
+#include "rt/view.h"
+
+typedef enum Measure { MEASURE_VISIBILITY, MEASURE_IRRADIANCE } Measure;
+const char *measure_name(Measure m);
+bool measure_parse(const char *name, Measure *m, Error *err);
+
+typedef struct ReferenceParams {
+    Measure measure;
+    int samples;             /* light samples per view sample (delta lights trace one) */
+    SamplingPattern pattern;
+    uint32_t seed;
+} ReferenceParams;
+
+#define REFERENCE_MAX_SAMPLES 1048576
+
+typedef struct Reference {
+    Image value;     /* visibility in [0,1] (1 or 3 channels) or outgoing radiance (3) */
+    Image std_error; /* standard error of value, same shape */
+    ReferenceParams params;
+    long long rays;  /* occlusion rays traced */
+} Reference;
+
+bool reference_params_check(const ReferenceParams *p, Error *err);
+/* Channels of the reference for this light and measure: 3 for textured
+ * lights and for irradiance, else 1. */
+int reference_channels(const Scene *scene, int light_index, Measure m);
+bool reference_compute(const RtScene *casters, const Scene *scene, int light_index, const ViewSamples *vs,
+                       const uint8_t *cls, const ReferenceParams *p, Reference *out, Error *err);
+void reference_free(Reference *ref);
+
+#endif

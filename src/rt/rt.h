@@ -1,0 +1,32 @@
+/* rt.h -- Embree 3 behind an opaque handle: one device per process (created
+ * on first use), and a BVH over all of a scene's objects or over its casters
+ * only. Embree's C types need `struct`; they do not leak past this layer
+ * except through rt_scene_handle(), for benchmarks and ray-cast techniques. */
+#ifndef SL_RT_H
+#define SL_RT_H
+#include <embree3/rtcore.h>
+#include <stddef.h>
+#include "scene/scene.h"
+
+typedef struct RtScene RtScene;
+
+typedef enum RtGeometrySet {
+    RT_ALL_OBJECTS, /* primary rays: everything visible */
+    RT_CASTERS,     /* occlusion rays: objects with caster = true */
+} RtGeometrySet;
+
+/* Thread count Embree's builders use; call before the first rt_scene_create. */
+void rt_set_threads(int threads);
+RtScene *rt_scene_create(const Scene *scene, RtGeometrySet set, Error *err);
+void rt_scene_release(RtScene *rs);
+RTCScene rt_scene_handle(const RtScene *rs);
+size_t rt_scene_bytes(const RtScene *rs);
+/* Object index of an Embree geometry id. */
+int rt_scene_object(const RtScene *rs, unsigned geom_id);
+
+/* Offset (world units) along the geometric normal that lifts a ray origin off
+ * the surface it was found on: scaled to the scene's extent and to the
+ * point's magnitude, since float error of a hit point grows with both. */
+float rt_ray_offset(float scene_extent, vec3 p_world);
+
+#endif

@@ -1,0 +1,39 @@
+/* light.h -- sampling of every light kind, shared by the Embree reference
+ * and by stochastic techniques (pbrt's split: sampling here, integration in
+ * the caller). Also the classification of a surface point against a light:
+ * back-facing points are "unlit by shading", not "in shadow" (course §1, Eq. 1.1
+ * restricts occluders to the positive half-space H+(p)). */
+#ifndef SL_LIGHT_H
+#define SL_LIGHT_H
+#include "scene/scene.h"
+
+/* Class of a view sample with respect to one light. Only SAMPLE_LIT_CANDIDATE
+ * samples enter shadow metrics. */
+typedef enum SampleClass {
+    SAMPLE_BACKGROUND = 0,    /* the primary ray hit nothing */
+    SAMPLE_LIT_CANDIDATE = 1, /* faces (part of) the light: visibility is measured */
+    SAMPLE_BACKFACING = 2,    /* normal faces away from the whole light */
+    SAMPLE_OUTSIDE_LIGHT = 3, /* outside a spot cone or behind a one-sided area light */
+    SAMPLE_NOT_RECEIVER = 4,  /* on an object flagged receiver = false */
+} SampleClass;
+#define SAMPLE_CLASS_COUNT 5
+const char *sample_class_name(SampleClass c);
+
+/* One sample of a light seen from a point p. */
+typedef struct LightSample {
+    vec3 dir_world;   /* unit direction from p to the light sample */
+    float dist;       /* distance to the sample point (world units); INFINITY for directional */
+    vec3 vis_weight;  /* weight of this sample's visibility: 1, or the emission image's RGB */
+    vec3 irradiance;  /* radiance estimator without the receiver cosine:
+                         L_e cos_q / (r^2 pdf_area), or its solid-angle equivalent */
+} LightSample;
+
+/* Sample the light from p_world with the 2D sample (u, v) in [0,1)^2. Delta
+ * lights (point, spot, directional) ignore (u, v). */
+LightSample light_sample(const Light *light, vec3 p_world, float u, float v);
+/* The light's centre sample (the point-light limit that `hard` tests). */
+LightSample light_sample_center(const Light *light, vec3 p_world);
+bool light_is_delta(const Light *light);
+SampleClass light_classify(const Light *light, vec3 p_world, vec3 n_world);
+
+#endif

@@ -1,0 +1,30 @@
+/* sandbox.h -- a Lua 5.4 state for untrusted scene files: only the base
+ * (minus file and code loading), math, string, table and utf8 libraries; text
+ * chunks only; a memory cap and an instruction budget, so a colleague's scene
+ * file cannot run commands, hang or exhaust memory. */
+#ifndef SL_SANDBOX_H
+#define SL_SANDBOX_H
+#include <stddef.h>
+#include <lua.h>
+#include "core/error.h"
+
+#define SANDBOX_MEMORY_LIMIT ((size_t)512 << 20) /* bytes */
+#define SANDBOX_INSTRUCTION_LIMIT 200000000L     /* Lua VM instructions per sandbox */
+
+typedef struct Sandbox Sandbox;
+
+Sandbox *sandbox_open(Error *err);
+void sandbox_close(Sandbox *sb);
+lua_State *sandbox_state(Sandbox *sb);
+
+/* Run a scene file; on success its returned table is on top of the stack. */
+bool sandbox_run_file(Sandbox *sb, const char *path, Error *err);
+/* Apply "a.b[2].c=value" to the table on top of the stack. The value is read
+ * as a Lua expression (number, boolean, {1,2,3}, "text"); a bare word that is
+ * not one is taken as a string. */
+bool sandbox_apply_override(Sandbox *sb, const char *spec, Error *err);
+/* Call the function at stack index fn_idx with nargs numbers; the number it
+ * returns goes to *out. The instruction budget still applies. */
+bool sandbox_call_number(Sandbox *sb, int fn_idx, const double *args, int nargs, double *out, Error *err);
+
+#endif

@@ -1,0 +1,28 @@
+/* registry.h -- the one table of techniques, and parameter handling that
+ * every front end shares: defaults, "name=value" parsing with typed range
+ * checks, and formatting. Errors name the parameter and its valid range. */
+#ifndef SL_REGISTRY_H
+#define SL_REGISTRY_H
+#include <stdio.h>
+#include "techniques/technique.h"
+
+int tech_count(void);
+const Technique *tech_at(int i);
+/* NULL and an error listing the known names when absent. */
+const Technique *tech_find(const char *name, Error *err);
+
+/* Fill values with every parameter's default. */
+void tech_params_default(const Technique *t, double *values);
+/* Parse "name=value" into values; unknown names and out-of-range or
+ * ill-typed values are refused with the parameter's range. */
+bool tech_param_parse(const Technique *t, const char *assignment, double *values, Error *err);
+/* Set one parameter by name from a number (ints, bools and enum indices too). */
+bool tech_param_set(const Technique *t, const char *name, double value, double *values, Error *err);
+int tech_param_index(const Technique *t, const char *name);
+/* The value as text: enum names, true/false, integers, %.9g floats. */
+void tech_param_format(const ParamDesc *p, double value, char *out, size_t n);
+/* The valid range as text: "[1, 64]", "one of: a, b", "true or false". */
+void tech_param_range(const ParamDesc *p, char *out, size_t n);
+const char *param_type_name(ParamType t);
+
+#endif

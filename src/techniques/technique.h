@@ -1,0 +1,56 @@
+/* technique.h -- what a shadow technique declares: the single declaration of
+ * its name, family, source section, typed parameters (default, range, unit,
+ * one-line doc), the resource kinds it may acquire, and a per-view-sample
+ * evaluation returning visibility in [0,1] (or RGB). The CLI, `list`, the Lua
+ * layer, the tests and the docs all read these declarations through the
+ * registry (registry.h); nothing lists techniques or parameters elsewhere. */
+#ifndef SL_TECHNIQUE_H
+#define SL_TECHNIQUE_H
+#include <stdint.h>
+#include "resources/resources.h"
+#include "rt/view.h"
+
+typedef enum ParamType { PARAM_INT, PARAM_FLOAT, PARAM_ENUM, PARAM_BOOL } ParamType;
+
+typedef struct ParamDesc {
+    const char *name;
+    ParamType type;
+    double def, min, max;        /* closed range; enums: index range; bools: [0, 1] */
+    const char *unit;            /* "world units", "texels", "radians", "" */
+    const char *doc;             /* one line */
+    const char *const *choices;  /* PARAM_ENUM: NULL-terminated names, value = index */
+} ParamDesc;
+
+#define TECH_MAX_PARAMS 32
+
+/* Everything an evaluation may read. Samples whose class is not
+ * SAMPLE_LIT_CANDIDATE may be skipped: the engine overwrites them. */
+typedef struct TechContext {
+    const Scene *scene;
+    int light_index;
+    const Light *light;
+    const ViewSamples *vs;
+    const uint8_t *cls;          /* SampleClass per view sample */
+    ResourceManager *rm;
+    const double *params;        /* values in declaration order */
+    int channels;                /* 1, or 3 for RGB visibility (textured lights) */
+} TechContext;
+
+typedef struct Technique {
+    const char *name;
+    const char *family;          /* "ray traced", "shadow map", "filtered", "soft", ... */
+    const char *source;          /* seed section it implements, e.g. "course §2.1" */
+    const char *summary;         /* one line */
+    const ParamDesc *params;
+    int num_params;
+    const char *const *resources;/* resource kinds it may acquire, NULL-terminated */
+    bool rgb;                    /* evaluates 3 channels when ctx->channels == 3 */
+    /* Acquire resources and build per-run state (may be NULL on success). */
+    bool (*prepare)(const TechContext *ctx, void **state, Error *err);
+    /* Visibility of samples [begin, end) into out[(s - begin) * channels + c];
+     * called in parallel on disjoint ranges. */
+    void (*evaluate)(const void *state, const TechContext *ctx, int begin, int end, float *out);
+    void (*release)(void *state);
+} Technique;
+
+#endif
