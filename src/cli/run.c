@@ -80,6 +80,7 @@ static bool run_stages(Job *j, int stages, double *metrics_s, Error *err)
         RefRequest rq = {j->light_index, j->o.ref, j->o.no_cache ? NULL : j->cache_dir};
         j->ref = res_reference(lab_resources(j->lab), lab_scene(j->lab), &rq, &j->ref_info, err);
         if (!j->ref) return false;
+        if (j->ref_info.cache_note[0]) fprintf(stderr, "shadowlab: warning: %s\n", j->ref_info.cache_note);
     }
     if (stages == (STAGE_RENDER | STAGE_REFERENCE)) {
         double t0 = timer_now_s();

@@ -88,6 +88,16 @@ int rm_log_count(const ResourceManager *rm) { return rm->log_count; }
 const ResourceEvent *rm_log_event(const ResourceManager *rm, int i) { return &rm->log[i]; }
 void rm_log_reset(ResourceManager *rm) { rm->log_count = 0; }
 
+void rm_log_note(ResourceManager *rm, const char *kind, uint64_t key, const char *note)
+{
+    for (int i = 0; i < rm->log_count; i++) {
+        ResourceEvent *ev = &rm->log[i];
+        if (ev->key != key || strcmp(ev->kind, kind) != 0) continue;
+        size_t n = strlen(ev->desc);
+        snprintf(ev->desc + n, sizeof ev->desc - n, " (%s)", note);
+    }
+}
+
 size_t rm_bytes(const ResourceManager *rm)
 {
     size_t b = 0;

@@ -46,6 +46,9 @@ void *rm_acquire(ResourceManager *rm, const ResourceKind *kind, uint64_t key, co
 int rm_log_count(const ResourceManager *rm);
 const ResourceEvent *rm_log_event(const ResourceManager *rm, int i);
 void rm_log_reset(ResourceManager *rm);
+/* Append a note to the logged description of (kind name, key), e.g. where a
+ * resource was loaded from. */
+void rm_log_note(ResourceManager *rm, const char *kind, uint64_t key, const char *note);
 
 /* Totals over everything the manager holds. */
 size_t rm_bytes(const ResourceManager *rm);

@@ -179,8 +179,7 @@ static void *build_reference(const void *args, Error *err)
         }
         if (st == REFCACHE_CORRUPT) {
             info->origin = REF_CACHE_CORRUPT_RECOMPUTED;
-            snprintf(info->cache_note, sizeof info->cache_note, "%s", why.msg);
-            fprintf(stderr, "shadowlab: warning: %s; recomputing the reference\n", why.msg);
+            snprintf(info->cache_note, sizeof info->cache_note, "%s; recomputed", why.msg);
         }
     }
     if (!compute_reference(a, ref, err)) {
@@ -191,7 +190,7 @@ static void *build_reference(const void *args, Error *err)
     if (a->req->cache_dir) {
         Error werr;
         if (!refcache_write(a->req->cache_dir, info->cache_path, info->key, ref, &werr))
-            fprintf(stderr, "shadowlab: warning: reference not cached: %s\n", werr.msg);
+            snprintf(info->cache_note, sizeof info->cache_note, "not cached: %s", werr.msg);
     }
     return ref;
 }
@@ -218,5 +217,7 @@ const Reference *res_reference(ResourceManager *rm, const Scene *scene, const Re
     char desc[160];
     snprintf(desc, sizeof desc, "light %d, %s, %d %s samples", req->light_index + 1,
              measure_name(req->params.measure), req->params.samples, sampling_pattern_name(req->params.pattern));
-    return rm_acquire(rm, &kind_reference, info->key, desc, build_reference, &a, err);
+    const Reference *ref = rm_acquire(rm, &kind_reference, info->key, desc, build_reference, &a, err);
+    if (ref && info->origin != REF_REUSED) rm_log_note(rm, kind_reference.name, info->key, ref_origin_name(info->origin));
+    return ref;
 }

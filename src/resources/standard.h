@@ -25,7 +25,7 @@ typedef struct RefInfo {
     RefOrigin origin;
     uint64_t key;
     char cache_path[1024];
-    char cache_note[512];   /* why a cache entry was rejected */
+    char cache_note[512];   /* why a cache entry was rejected, or why none was written */
     double seconds;         /* compute or load time */
     double rays_per_second; /* of the computation that made it (0 when loaded) */
 } RefInfo;

@@ -42,7 +42,8 @@ static bool alloc_samples(ViewSamples *vs, int w, int h, Error *err)
     vs->n_shading_world = malloc(n * sizeof(vec3));
     vs->depth_view = malloc(n * sizeof(float));
     vs->object = malloc(n * sizeof(int32_t));
-    if (vs->p_world && vs->n_geom_world && vs->n_shading_world && vs->depth_view && vs->object) return true;
+    vs->prim = malloc(n * sizeof(int32_t));
+    if (vs->p_world && vs->n_geom_world && vs->n_shading_world && vs->depth_view && vs->object && vs->prim) return true;
     view_samples_free(vs);
     return error_set(err, "out of memory for %dx%d view samples", w, h);
 }
@@ -62,6 +63,7 @@ static void store_hit(ViewSamples *vs, int s, const Scene *scene, const RtScene 
 {
     int obj = rt_scene_object(rs, rh->hit.geomID);
     vs->object[s] = obj;
+    vs->prim[s] = (int32_t)rh->hit.primID;
     vec3 ng = v3_normalize_or(v3(rh->hit.Ng_x, rh->hit.Ng_y, rh->hit.Ng_z), v3_scale(dir, -1.0f));
     if (v3_dot(ng, dir) > 0.0f) ng = v3_scale(ng, -1.0f);
     vs->n_geom_world[s] = ng;
@@ -95,7 +97,7 @@ bool view_samples_trace(const RtScene *rs, const Scene *scene, ViewSamples *vs, 
             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
             rtcIntersect1(rtc, &ctx, &rh);
             if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-                vs->object[s] = -1;
+                vs->object[s] = vs->prim[s] = -1;
                 vs->p_world[s] = vs->n_geom_world[s] = vs->n_shading_world[s] = v3(0, 0, 0);
                 vs->depth_view[s] = INFINITY;
             } else {
@@ -113,12 +115,13 @@ void view_samples_free(ViewSamples *vs)
     free(vs->n_shading_world);
     free(vs->depth_view);
     free(vs->object);
+    free(vs->prim);
     *vs = (ViewSamples){0};
 }
 
 size_t view_samples_bytes(const ViewSamples *vs)
 {
-    return (size_t)vs->count * (3 * sizeof(vec3) + sizeof(float) + sizeof(int32_t));
+    return (size_t)vs->count * (3 * sizeof(vec3) + sizeof(float) + 2 * sizeof(int32_t));
 }
 
 void view_samples_classify(const ViewSamples *vs, const Scene *scene, int light_index, uint8_t *cls)

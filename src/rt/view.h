@@ -16,6 +16,7 @@ typedef struct ViewSamples {
     vec3 *n_shading_world; /* unit interpolated vertex normal, same hemisphere */
     float *depth_view;     /* distance along the camera's view axis (world units) */
     int32_t *object;       /* object index, -1 for background */
+    int32_t *prim;         /* triangle index within the object's mesh */
 } ViewSamples;
 
 bool view_samples_trace(const RtScene *all, const Scene *scene, ViewSamples *vs, Error *err);

@@ -20,7 +20,9 @@ bool rd_fail(LuaReader *r, const char *key, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    return error_set(r->err, "%s: %s %s", r->file, key_path(r, key, where, sizeof where), msg);
+    /* "key = 3 outside ..." reads with a space; "key: <nested error>" without. */
+    const char *sep = msg[0] == ':' ? "" : " ";
+    return error_set(r->err, "%s: %s%s%s", r->file, key_path(r, key, where, sizeof where), sep, msg);
 }
 
 size_t rd_enter_key(LuaReader *r, const char *key)

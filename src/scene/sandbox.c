@@ -80,11 +80,18 @@ void sandbox_close(Sandbox *sb)
 
 lua_State *sandbox_state(Sandbox *sb) { return sb->L; }
 
-static bool pcall_or_error(lua_State *L, int nargs, int nres, Error *err)
+/* Run the function on the stack; errors are prefixed with the file when Lua
+ * gave no position (errors raised from the hook or the allocator). */
+static bool pcall_or_error(lua_State *L, const char *path, int nargs, int nres, Error *err)
 {
-    if (lua_pcall(L, nargs, nres, 0) == LUA_OK) return true;
+    int st = lua_pcall(L, nargs, nres, 0);
+    if (st == LUA_OK) return true;
     const char *msg = lua_tostring(L, -1);
-    error_set(err, "%s", msg ? msg : "error (no message)");
+    if (st == LUA_ERRMEM)
+        error_set(err, "%s: out of memory: the scene exceeds the sandbox's %zu MiB limit", path,
+                  SANDBOX_MEMORY_LIMIT >> 20);
+    else if (msg && strncmp(msg, path, strlen(path)) == 0) error_set(err, "%s", msg);
+    else error_set(err, "%s: %s", path, msg ? msg : "error (no message)");
     lua_pop(L, 1);
     return false;
 }
@@ -99,7 +106,7 @@ bool sandbox_run_file(Sandbox *sb, const char *path, Error *err)
         lua_pop(L, 1);
         return false;
     }
-    if (!pcall_or_error(L, 0, 1, err)) return false;
+    if (!pcall_or_error(L, path, 0, 1, err)) return false;
     if (!lua_istable(L, -1)) {
         lua_pop(L, 1);
         return error_set(err, "%s: the scene file must return a table", path);
@@ -181,7 +188,7 @@ bool sandbox_call_number(Sandbox *sb, int fn_idx, const double *args, int nargs,
     fn_idx = lua_absindex(L, fn_idx);
     lua_pushvalue(L, fn_idx);
     for (int i = 0; i < nargs; i++) lua_pushnumber(L, args[i]);
-    if (!pcall_or_error(L, nargs, 1, err)) return false;
+    if (!pcall_or_error(L, "function", nargs, 1, err)) return false;
     int isnum;
     *out = lua_tonumberx(L, -1, &isnum);
     if (!isnum) error_set(err, "function returned a %s, expected a number", luaL_typename(L, -1));

@@ -9,7 +9,7 @@
 #include "core/error.h"
 
 #define SANDBOX_MEMORY_LIMIT ((size_t)512 << 20) /* bytes */
-#define SANDBOX_INSTRUCTION_LIMIT 200000000L     /* Lua VM instructions per sandbox */
+#define SANDBOX_INSTRUCTION_LIMIT 100000000L     /* Lua VM instructions per sandbox (~2 s) */
 
 typedef struct Sandbox Sandbox;
 

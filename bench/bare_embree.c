@@ -1,0 +1,364 @@
+/* bare_embree.c -- the reference's throughput against a bare Embree loop.
+ * Both trace the same occlusion rays: the scene's casters BVH, view samples
+ * and classes from the lab's resource manager; for every lit-candidate sample
+ * the reference's origin offset, sample stream (r2, seed 1) and light samples,
+ * in packets of 16 with rtcOccluded16 over rows (OpenMP, dynamic 1). The bare
+ * loop only counts unoccluded rays; reference_compute does everything it
+ * does. Rounds alternate bare, reference (after one untimed warm-up round);
+ * every round checks that both saw the same rays, medians are reported and
+ * one CSV row is added to reports/bench/reference_throughput.csv.
+ * Usage: bare_embree [SCENE] [-n SAMPLES] [--threads N] [--repeat R] [-o CSV] */
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "core/fsutil.h"
+#include "core/timer.h"
+#include "lab/lab.h"
+#include "version.h"
+
+#define PACKET 16
+#define SEED 1u
+#define PATTERN SAMPLING_R2
+#define CSV_HEADER                                                                                              \
+    "scene,triangles,samples,threads,rays,bare_rays_per_s,reference_rays_per_s,ratio,commit,cpu_model,date\n"
+
+typedef struct Options {
+    const char *scene, *csv;
+    int samples, threads, repeat;
+} Options;
+
+/* What both loops trace, fetched once (untimed). */
+typedef struct Inputs {
+    const Scene *scene;
+    const RtScene *casters;
+    const ViewSamples *vs;
+    const uint8_t *cls;
+    int light_index;
+    int count;      /* rays per candidate sample: N, or 1 for delta lights */
+    long long rays; /* rays per pass */
+} Inputs;
+
+/* Medians over the timed rounds. */
+typedef struct Result {
+    double bare_s, ref_s, ratio; /* ratio: median of per-round bare_s / ref_s */
+} Result;
+
+static int usage(const char *msg)
+{
+    fprintf(stderr, "bare_embree: %s\nusage: bare_embree [SCENE] [-n SAMPLES] [--threads N] [--repeat R] [-o CSV]\n",
+            msg);
+    return 1;
+}
+
+static bool parse_int(const char *s, int lo, int hi, int *out)
+{
+    char *end;
+    long v = s ? strtol(s, &end, 10) : 0;
+    if (!s || end == s || *end != '\0' || v < lo || v > hi) return false;
+    *out = (int)v;
+    return true;
+}
+
+static bool parse_options(int argc, char **argv, Options *o)
+{
+    *o = (Options){"scenes/sphere-on-plane.lua", "reports/bench/reference_throughput.csv", 256,
+                   omp_get_max_threads(), 5};
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        bool ok;
+        if (strcmp(a, "-n") == 0) ok = parse_int(v, 1, REFERENCE_MAX_SAMPLES, &o->samples);
+        else if (strcmp(a, "--threads") == 0) ok = parse_int(v, 1, 1024, &o->threads);
+        else if (strcmp(a, "--repeat") == 0) ok = parse_int(v, 1, 1000, &o->repeat);
+        else if (strcmp(a, "-o") == 0) ok = (o->csv = v) != NULL;
+        else if (a[0] != '-') { o->scene = a; continue; }
+        else return false;
+        if (!ok) return false;
+        i++;
+    }
+    return true;
+}
+
+static ReferenceParams ref_params(const Options *o)
+{
+    return (ReferenceParams){MEASURE_VISIBILITY, o->samples, PATTERN, SEED};
+}
+
+static bool load_inputs(Lab *lab, const Options *o, Inputs *in, Error *err)
+{
+    ResourceManager *rm = lab_resources(lab);
+    in->scene = lab_scene(lab);
+    if (!lab_light_index(lab, 1, &in->light_index, err)) return false;
+    in->casters = res_bvh(rm, in->scene, RT_CASTERS, err);
+    in->vs = in->casters ? res_view_samples(rm, in->scene, err) : NULL;
+    in->cls = in->vs ? res_classes(rm, in->scene, in->light_index, err) : NULL;
+    if (!in->cls) return false;
+    in->count = light_is_delta(&in->scene->lights[in->light_index]) ? 1 : o->samples;
+    long long candidates = 0;
+    for (int s = 0; s < in->vs->count; s++) candidates += in->cls[s] == SAMPLE_LIT_CANDIDATE;
+    in->rays = candidates * in->count;
+    return true;
+}
+
+/* ---- the bare loop ------------------------------------------------------ */
+
+/* Fields that no ray of a thread ever changes. */
+static void packet_init(struct RTCRay16 *r)
+{
+    for (int k = 0; k < PACKET; k++) {
+        r->tnear[k] = 0.0f;
+        r->time[k] = 0.0f;
+        r->mask[k] = 0xFFFFFFFFu;
+        r->id[k] = (unsigned)k;
+        r->flags[k] = 0;
+    }
+}
+
+static void packet_origin(struct RTCRay16 *r, vec3 org)
+{
+    for (int k = 0; k < PACKET; k++) {
+        r->org_x[k] = org.x; r->org_y[k] = org.y; r->org_z[k] = org.z;
+    }
+}
+
+static void packet_fill(struct RTCRay16 *r, int *valid, const Light *l, vec3 p, uint32_t stream, int first,
+                        int count)
+{
+    for (int k = 0; k < PACKET; k++) {
+        int i = first + k;
+        valid[k] = i < count ? -1 : 0;
+        if (i >= count) continue;
+        float u, v;
+        sample_2d(PATTERN, stream, i, count, &u, &v);
+        LightSample s = light_sample(l, p, u, v);
+        r->dir_x[k] = s.dir_world.x; r->dir_y[k] = s.dir_world.y; r->dir_z[k] = s.dir_world.z;
+        r->tfar[k] = isinf(s.dist) ? INFINITY : s.dist * (1.0f - 1e-5f);
+    }
+}
+
+static long long packet_unoccluded(const struct RTCRay16 *r, const int *valid)
+{
+    long long n = 0;
+    for (int k = 0; k < PACKET; k++) n += valid[k] && r->tfar[k] != -INFINITY;
+    return n;
+}
+
+static long long bare_sample(const Inputs *in, RTCScene rtc, float extent, int s, struct RTCIntersectContext *ctx,
+                             struct RTCRay16 *r, int *valid)
+{
+    vec3 p = in->vs->p_world[s];
+    packet_origin(r, v3_madd(p, in->vs->n_geom_world[s], rt_ray_offset(extent, p)));
+    uint32_t stream = sampling_stream(SEED, (uint32_t)s);
+    const Light *l = &in->scene->lights[in->light_index];
+    long long lit = 0;
+    for (int first = 0; first < in->count; first += PACKET) {
+        packet_fill(r, valid, l, p, stream, first, in->count);
+        rtcOccluded16(valid, rtc, ctx, r);
+        lit += packet_unoccluded(r, valid);
+    }
+    return lit;
+}
+
+/* One pass over every lit candidate; returns the unoccluded ray count. */
+static long long bare_trace(const Inputs *in)
+{
+    RTCScene rtc = rt_scene_handle(in->casters);
+    float extent = scene_extent(in->scene);
+    const ViewSamples *vs = in->vs;
+    long long lit = 0;
+#pragma omp parallel reduction(+ : lit)
+    {
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        struct RTCRay16 ray;
+        _Alignas(64) int valid[PACKET];
+        packet_init(&ray);
+#pragma omp for schedule(dynamic, 1)
+        for (int y = 0; y < vs->height; y++)
+            for (int s = y * vs->width; s < (y + 1) * vs->width; s++)
+                if (in->cls[s] == SAMPLE_LIT_CANDIDATE) lit += bare_sample(in, rtc, extent, s, &ctx, &ray, valid);
+    }
+    return lit;
+}
+
+/* ---- rounds and the agreement check ------------------------------------- */
+
+/* Unoccluded rays the reference saw: round(visibility * count) per candidate. */
+static long long reference_unoccluded(const Inputs *in, const Reference *ref)
+{
+    long long n = 0;
+    for (int s = 0; s < in->vs->count; s++)
+        if (in->cls[s] == SAMPLE_LIT_CANDIDATE) n += llround((double)ref->value.data[s] * in->count);
+    return n;
+}
+
+static bool check_agreement(const Inputs *in, const Reference *ref, long long bare_lit, Error *err)
+{
+    if (ref->rays != in->rays)
+        return error_set(err, "MISMATCH: the reference traced %lld rays, the bare loop %lld", ref->rays, in->rays);
+    if (ref->value.channels != 1) return true; /* RGB-weighted visibility: no ray count to recover */
+    long long ref_lit = reference_unoccluded(in, ref);
+    if (ref_lit != bare_lit)
+        return error_set(err, "MISMATCH: unoccluded rays: reference %lld, bare loop %lld (of %lld)", ref_lit,
+                         bare_lit, in->rays);
+    return true;
+}
+
+/* One bare pass then one reference pass, timed, and checked against each other. */
+static bool run_round(const Inputs *in, const ReferenceParams *prm, double *bare_s, double *ref_s, Error *err)
+{
+    double t0 = timer_now_s();
+    long long lit = bare_trace(in);
+    double t1 = timer_now_s();
+    Reference ref;
+    bool ok = reference_compute(in->casters, in->scene, in->light_index, in->vs, in->cls, prm, &ref, err);
+    double t2 = timer_now_s();
+    if (!ok) return false;
+    *bare_s = t1 - t0;
+    *ref_s = t2 - t1;
+    ok = check_agreement(in, &ref, lit, err);
+    reference_free(&ref);
+    return ok;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static bool measure(const Inputs *in, const Options *o, Result *res, Error *err)
+{
+    ReferenceParams prm = ref_params(o);
+    double warm_b, warm_r, *t = malloc(sizeof(double) * 3 * (size_t)o->repeat);
+    if (!t) return error_set(err, "out of memory");
+    double *bare = t, *ref = t + o->repeat, *ratio = t + 2 * o->repeat;
+    bool ok = run_round(in, &prm, &warm_b, &warm_r, err);
+    for (int i = 0; ok && i < o->repeat; i++) {
+        ok = run_round(in, &prm, &bare[i], &ref[i], err);
+        ratio[i] = bare[i] / ref[i];
+    }
+    if (ok) *res = (Result){median(bare, o->repeat), median(ref, o->repeat), median(ratio, o->repeat)};
+    free(t);
+    return ok;
+}
+
+/* ---- the record --------------------------------------------------------- */
+
+static void cpu_model(char *out, size_t n)
+{
+    snprintf(out, n, "unknown");
+    FILE *fp = fopen("/proc/cpuinfo", "r");
+    if (!fp) return;
+    char line[512];
+    while (fgets(line, sizeof line, fp)) {
+        char *colon = strchr(line, ':');
+        if (strncmp(line, "model name", 10) == 0 && colon) {
+            snprintf(out, n, "%s", colon + 2);
+            out[strcspn(out, "\n")] = '\0';
+            break;
+        }
+    }
+    fclose(fp);
+}
+
+/* A CSV field, quoted when it holds a comma, quote or newline. */
+static void csv_field(FILE *fp, const char *s)
+{
+    if (!strpbrk(s, ",\"\n")) { fputs(s, fp); return; }
+    fputc('"', fp);
+    for (; *s; s++) {
+        if (*s == '"') fputc('"', fp);
+        fputc(*s, fp);
+    }
+    fputc('"', fp);
+}
+
+static void write_row(FILE *fp, const Inputs *in, const Options *o, const Result *r)
+{
+    char cpu[256], date[32];
+    time_t now = time(NULL);
+    strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
+    cpu_model(cpu, sizeof cpu);
+    csv_field(fp, in->scene->name);
+    fprintf(fp, ",%d,%d,%d,%lld,%.0f,%.0f,%.4f,", in->scene->num_triangles, o->samples, o->threads, in->rays,
+            in->rays / r->bare_s, in->rays / r->ref_s, r->ratio);
+    csv_field(fp, SHADOWLAB_COMMIT);
+    fputc(',', fp);
+    csv_field(fp, cpu);
+    fprintf(fp, ",%s\n", date);
+}
+
+/* Rows already in the file, if it has this header; a file with another header is replaced. */
+static char *previous_rows(const char *path)
+{
+    if (!file_exists(path)) return NULL;
+    Error ignored;
+    char *text = file_read_all(path, NULL, &ignored);
+    if (text && strncmp(text, CSV_HEADER, strlen(CSV_HEADER)) == 0) return text;
+    fprintf(stderr, "bare_embree: note: %s has another header; starting it afresh\n", path);
+    free(text);
+    return NULL;
+}
+
+/* Add one row: the old rows plus the new one go to a fresh file, renamed into place. */
+static bool append_csv(const char *path, const Inputs *in, const Options *o, const Result *r, Error *err)
+{
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (slash) *slash = '\0';
+    if (slash && !mkdir_p(dir, err)) return false;
+    char *old = previous_rows(path);
+    AtomicFile af;
+    if (!atomic_open(&af, path, err)) { free(old); return false; }
+    fputs(old ? old : CSV_HEADER, af.fp);
+    free(old);
+    write_row(af.fp, in, o, r);
+    return atomic_commit(&af, err);
+}
+
+static void print_summary(const Inputs *in, const Options *o, const Result *r)
+{
+    printf("%s: %d triangles, %lld rays per pass, %d samples, %d threads\n", in->scene->name,
+           in->scene->num_triangles, in->rays, o->samples, o->threads);
+    printf("reference %.1f Mrays/s, bare %.1f Mrays/s, ratio %.2f (median of %d)\n", in->rays / r->ref_s * 1e-6,
+           in->rays / r->bare_s * 1e-6, r->ratio, o->repeat);
+}
+
+static bool bench(const Options *o, Error *err)
+{
+    Lab *lab = lab_open(o->scene, NULL, 0, err);
+    if (!lab) return false;
+    Inputs in;
+    Result r;
+    bool ok = load_inputs(lab, o, &in, err) && measure(&in, o, &r, err);
+    if (ok) {
+        print_summary(&in, o, &r);
+        ok = append_csv(o->csv, &in, o, &r, err);
+    }
+    lab_close(lab);
+    return ok;
+}
+
+int main(int argc, char **argv)
+{
+    Options o;
+    if (!parse_options(argc, argv, &o)) return usage("bad arguments");
+    omp_set_num_threads(o.threads);
+    rt_set_threads(o.threads);
+    Error err;
+    if (!bench(&o, &err)) {
+        fprintf(stderr, "bare_embree: %s\n", err.msg);
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,2 @@
+-- a scene that never returns
+while true do end

@@ -1,0 +1,3 @@
+-- a scene that tries to run a command
+os.execute("touch /tmp/shadowlab-pwned")
+return {}

@@ -1,0 +1,58 @@
+/* test_registry.c -- the technique registry: every parameter is typed,
+ * documented and has its default inside its range; out-of-range, ill-typed
+ * and unknown values are refused with the parameter's name and range. */
+#include <string.h>
+#include "techniques/registry.h"
+#include "test.h"
+
+TEST(test_registry_declarations_are_complete)
+{
+    CHECK(tech_count() >= 1);
+    for (int i = 0; i < tech_count(); i++) {
+        const Technique *t = tech_at(i);
+        CHECK_MSG(t->name && t->family && t->source && t->summary && t->resources, "technique %d", i);
+        CHECK_MSG(t->prepare && t->evaluate, "%s: no prepare/evaluate", t->name);
+        CHECK(t->num_params <= TECH_MAX_PARAMS);
+        Error err;
+        CHECK_MSG(tech_find(t->name, &err) == t, "%s is not found by name", t->name);
+        for (int j = 0; j < i; j++) CHECK_MSG(strcmp(tech_at(j)->name, t->name) != 0, "duplicate %s", t->name);
+        for (int k = 0; k < t->num_params; k++) {
+            const ParamDesc *p = &t->params[k];
+            CHECK_MSG(p->name && p->doc && p->doc[0] && p->unit, "%s: parameter %d undocumented", t->name, k);
+            CHECK_MSG(p->min <= p->def && p->def <= p->max, "%s.%s: default %g outside [%g, %g]", t->name,
+                      p->name, p->def, p->min, p->max);
+            CHECK_MSG(p->type != PARAM_ENUM || p->choices, "%s.%s: enum without choices", t->name, p->name);
+        }
+    }
+}
+
+TEST(test_registry_refuses_bad_values_with_the_range)
+{
+    for (int i = 0; i < tech_count(); i++) {
+        const Technique *t = tech_at(i);
+        double v[TECH_MAX_PARAMS];
+        tech_params_default(t, v);
+        Error err;
+        CHECK(!tech_param_parse(t, "no_such_parameter=1", v, &err));
+        CHECK_MSG(strstr(err.msg, "no_such_parameter"), "%s", err.msg);
+        for (int k = 0; k < t->num_params; k++) {
+            const ParamDesc *p = &t->params[k];
+            char assign[256], range[256];
+            tech_param_range(p, range, sizeof range);
+            snprintf(assign, sizeof assign, "%s=%.17g", p->name, p->max + 1.0);
+            CHECK_MSG(!tech_param_parse(t, assign, v, &err), "%s accepted", assign);
+            CHECK_MSG(strstr(err.msg, p->name) && strstr(err.msg, range), "message lacks name or range: %s", err.msg);
+            snprintf(assign, sizeof assign, "%s=%.17g", p->name, p->min - 1.0);
+            CHECK_MSG(!tech_param_parse(t, assign, v, &err), "%s accepted", assign);
+            snprintf(assign, sizeof assign, "%s=nan", p->name);
+            CHECK_MSG(!tech_param_parse(t, assign, v, &err), "%s accepted", assign);
+            snprintf(assign, sizeof assign, "%s=banana", p->name);
+            CHECK_MSG(!tech_param_parse(t, assign, v, &err), "%s accepted", assign);
+            char def[64];
+            tech_param_format(p, p->def, def, sizeof def);
+            snprintf(assign, sizeof assign, "%s=%s", p->name, def);
+            CHECK_MSG(tech_param_parse(t, assign, v, &err), "%s refused: %s", assign, err.msg);
+            CHECK(v[k] == p->def);
+        }
+    }
+}
