@@ -64,10 +64,7 @@ $(B)/test_unit_san: $(TEST_SAN) $(SAN_OBJ)
 
 # Unit tests once under ASan+UBSan, then the CLI tests on the optimised build.
 test: all $(B)/test_unit_san
-	@SHADOWLAB_MODEL_PATH=$${SHADOWLAB_MODEL_PATH:-../shared/models} \
-	    ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-	    SHADOWLAB_PLUGIN_DIR=$(CURDIR)/$(B) ./$(B)/test_unit_san
-	@./tests/cli/run.sh $(B)/shadowlab
+	@./tests/run.sh
 test-unit: all $(B)/test_unit
 	SHADOWLAB_MODEL_PATH=$${SHADOWLAB_MODEL_PATH:-../shared/models} SHADOWLAB_PLUGIN_DIR=$(CURDIR)/$(B) ./$(B)/test_unit $(T)
 
