@@ -23,7 +23,7 @@ TEST_OBJ:= $(TEST_SRC:%.c=$(B)/obj/%.o)
 TEST_SAN:= $(TEST_SRC:%.c=$(B)/san/%.o)
 PLUGIN  := $(B)/libshadowlab_oiio.so
 
-.PHONY: all deps test test-unit demo bench clean FORCE
+.PHONY: all deps test test-unit demo bench docs clean FORCE
 all: $(B)/shadowlab $(PLUGIN)
 
 $(DEPS): scripts/deps.sh
@@ -70,6 +70,10 @@ test-unit: all $(B)/test_unit
 
 demo: all
 	./scripts/demo.sh $(B)/shadowlab reports/demo
+
+# The technique reference is generated from the registry.
+docs: all
+	./$(B)/shadowlab list --markdown > docs/techniques.md
 
 bench: all
 	$(MAKE) -C bench

@@ -50,6 +50,8 @@ static bool parse_option(char **argv, int *i, int argc, CliOptions *o, Error *er
         if (is(a, "--no-cache", NULL)) o->no_cache = true;
         else if (is(a, "--no-png", NULL)) o->no_png = true;
         else if (is(a, "--json", NULL)) o->json = true;
+        else if (is(a, "--names", NULL)) o->names = true;
+        else if (is(a, "--markdown", NULL)) o->markdown = true;
         else if (is(a, "--help", "-h")) o->help = true;
         else return error_set(err, "unknown option '%s'", a);
     }

@@ -20,7 +20,7 @@ typedef struct CliOptions {
     int threads, repeat, light;
     ReferenceParams ref;
     const char *cache_dir; /* NULL: default */
-    bool no_cache, no_png, json, help;
+    bool no_cache, no_png, json, names, markdown, help;
 } CliOptions;
 
 /* Parse argv after the command name; usage errors are reported in err.

@@ -69,6 +69,10 @@ if command -v python3 >/dev/null && python3 -c 'import json,sys; d=json.load(ope
     ok list_json_parses
 elif ! command -v python3 >/dev/null; then ok list_json_parses_skipped_no_python; else no list_json_parses "invalid JSON"; fi
 
+"$SL" list --markdown >"$TMP/techniques.md" 2>"$TMP/err"
+if cmp -s "$TMP/techniques.md" "$ROOT/docs/techniques.md"; then ok docs_techniques_generated_from_registry
+else no docs_techniques_generated_from_registry "docs/techniques.md is stale: run make docs"; fi
+
 # compare writes every output and its record; a second run reads the cache.
 OUT=$TMP/cmp
 SMALL="-s camera.width=96 -s camera.height=72"
