@@ -1,8 +1,8 @@
--- bunny: the 69,451-triangle Stanford bunny standing on a ground plane under a
--- spherical light: fine, self-shadowing detail (ears, haunch) and a soft
--- contact shadow, the test model of seed 001 (Chun & Oh). Units: world units
--- (the raw scan spans ~0.15; it is scaled x10 to ~1.5 units tall), degrees.
--- Falls back to glmark2-data's bunny.obj, which needs a different transform.
+-- bunny: the 69,451-triangle Stanford bunny (seed 001, Chun & Oh) on a ground
+-- plane under a spherical light: fine self-shadowing detail (ears, haunch) and
+-- soft ear shadows on the floor. Units: world units (the scan is ~0.15 units,
+-- scaled x10 here to ~1.5 tall), degrees. Needs the model search path for
+-- stanford-bunny.obj; glmark2's bunny.obj is the fallback (see below).
 return {
   name = "bunny",
   camera = {
@@ -14,9 +14,13 @@ return {
   },
   objects = {
     { name = "ground", shape = "plane", size = {8, 8}, albedo = {0.8, 0.8, 0.8} },
-    -- Stanford bounding box: x [-0.0947, 0.0610], y [0.0330, 0.1873],
-    -- z [-0.0619, 0.0588]; scaled x10, centred in x/z, feet on y = 0.
+    -- stanford-bunny.obj spans x [-0.0947, 0.0610], y [0.0330, 0.1873],
+    -- z [-0.0619, 0.0588] (Y up): scaled x10, centred in x and z, feet at y = 0.
+    -- glmark2-data's bunny.obj is the same scan normalised to x [-1, 1] and
+    -- centred on its bounding box (12.845x larger, same axes): it needs
+    -- scale = 0.7785, translate = {0, 0.7717, 0} instead; with the transform
+    -- below it comes out ~20 units wide and swallows the camera.
     { name = "bunny", shape = "mesh", model = {"stanford-bunny.obj", "bunny.obj"},
-      scale = 10, translate = {0.168, -0.330, 0.015}, albedo = {0.85, 0.78, 0.65} },
+      scale = 10, translate = {0.1684, -0.3299, 0.0154}, albedo = {0.85, 0.78, 0.65} },
   },
 }

@@ -10,40 +10,19 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/fsutil.h"
-#include "scene/mesh.h"
+#include "scene/mesh_builder.h"
 
 /* Growable array; len and cap count elements of `size` bytes. */
-typedef struct Buf {
-    void *data;
-    size_t len, cap, size;
-} Buf;
-
 typedef struct ObjReader {
     const char *path;
     Error *err;
     long line;
-    Buf pos;                /* vec3 */
-    Buf idx;                /* uint32_t, three per triangle */
+    MeshBuilder mb;              /* vertices and triangles read so far */
     size_t num_texcoords;   /* counted only to check face references */
     size_t num_normals;
 } ObjReader;
 
 static const char *const obj_ignored[] = {"o", "g", "s", "usemtl", "mtllib", "l", "p"};
-
-static bool buf_reserve(Buf *b, size_t extra)
-{
-    if (b->cap - b->len >= extra) return true;
-    size_t cap = b->cap ? b->cap : 4096;
-    while (cap - b->len < extra) {
-        if (cap > SIZE_MAX / 2 / b->size) return false;
-        cap *= 2;
-    }
-    void *p = realloc(b->data, cap * b->size);
-    if (!p) return false;
-    b->data = p;
-    b->cap = cap;
-    return true;
-}
 
 static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 static bool at_end(char c) { return c == '\0' || c == '#'; }
@@ -99,10 +78,8 @@ static bool obj_vertex(ObjReader *r, const char *s)
 {
     float v[4];
     if (!obj_numbers(r, s, "v", "vertex coordinate", 3, 4, v)) return false;
-    if (r->pos.len >= INT_MAX) return obj_fail(r, "too many vertices (limit %d)", INT_MAX);
-    if (!buf_reserve(&r->pos, 1)) return obj_fail(r, "out of memory");
-    ((vec3 *)r->pos.data)[r->pos.len++] = v3(v[0], v[1], v[2]);
-    return true;
+    const char *why = mb_add_vertex(&r->mb, v3(v[0], v[1], v[2]));
+    return !why || obj_fail(r, "%s", why);
 }
 
 /* vt or vn: validated and counted, values unused. */
@@ -138,7 +115,7 @@ static bool obj_face_vertex(ObjReader *r, const char **sp, uint32_t *out)
 {
     const char *tok = *sp, *s = tok;
     size_t v, unused;
-    if (!obj_index(r, &s, tok, "face", r->pos.len, &v)) return false;
+    if (!obj_index(r, &s, tok, "face", r->mb.num_pos, &v)) return false;
     if (*s == '/') {
         s++;
         if (*s != '/' && !obj_index(r, &s, tok, "texture", r->num_texcoords, &unused)) return false;
@@ -155,14 +132,8 @@ static bool obj_face_vertex(ObjReader *r, const char **sp, uint32_t *out)
 
 static bool obj_triangle(ObjReader *r, uint32_t a, uint32_t b, uint32_t c)
 {
-    if (r->idx.len / 3 >= INT_MAX) return obj_fail(r, "too many triangles (limit %d)", INT_MAX);
-    if (!buf_reserve(&r->idx, 3)) return obj_fail(r, "out of memory");
-    uint32_t *t = (uint32_t *)r->idx.data + r->idx.len;
-    t[0] = a;
-    t[1] = b;
-    t[2] = c;
-    r->idx.len += 3;
-    return true;
+    const char *why = mb_add_triangle(&r->mb, a, b, c);
+    return !why || obj_fail(r, "%s", why);
 }
 
 /* f: a polygon of three or more vertices, fan-triangulated around the first. */
@@ -215,27 +186,15 @@ static bool obj_parse(ObjReader *r, char *buf, size_t size)
     return true;
 }
 
-static bool obj_finish(ObjReader *r, Mesh *mesh)
-{
-    size_t nt = r->idx.len / 3;
-    if (nt == 0) return error_set(r->err, "%s: no triangles", r->path);
-    if (!mesh_alloc(mesh, (int)r->pos.len, (int)nt, r->err)) return error_prefix(r->err, "%s: ", r->path);
-    memcpy(mesh->positions, r->pos.data, r->pos.len * sizeof(vec3));
-    memcpy(mesh->indices, r->idx.data, r->idx.len * sizeof(uint32_t));
-    mesh_compute_normals(mesh);
-    return true;
-}
-
 bool mesh_load_obj(const char *path, Mesh *mesh, Error *err)
 {
     memset(mesh, 0, sizeof *mesh);
     size_t size;
     char *buf = file_read_all(path, &size, err);
     if (!buf) return false;
-    ObjReader r = {.path = path, .err = err, .pos.size = sizeof(vec3), .idx.size = sizeof(uint32_t)};
-    bool ok = obj_parse(&r, buf, size) && obj_finish(&r, mesh);
+    ObjReader r = {.path = path, .err = err};
+    bool ok = obj_parse(&r, buf, size) && mb_finish(&r.mb, path, mesh, err);
     free(buf);
-    free(r.pos.data);
-    free(r.idx.data);
+    mb_free(&r.mb);
     return ok;
 }

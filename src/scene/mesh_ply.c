@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/fsutil.h"
-#include "scene/mesh.h"
+#include "scene/mesh_builder.h"
 
 enum { PLY_MAX_ELEMENTS = 16, PLY_MAX_PROPERTIES = 48, PLY_NAME_MAX = 64 };
 
@@ -52,11 +52,6 @@ typedef struct PlyElement {
 } PlyElement;
 
 /* Growable array; len and cap count elements of `size` bytes. */
-typedef struct Buf {
-    void *data;
-    size_t len, cap, size;
-} Buf;
-
 typedef struct PlyReader {
     const char *path;
     Error *err;
@@ -70,24 +65,8 @@ typedef struct PlyReader {
     long line;                   /* current text line */
     const PlyElement *cur_elem;  /* element being read; NULL in the header */
     long record;
-    Buf pos;                     /* vec3 */
-    Buf idx;                     /* uint32_t, three per triangle */
+    MeshBuilder mb;              /* vertices and triangles read so far */
 } PlyReader;
-
-static bool buf_reserve(Buf *b, size_t extra)
-{
-    if (b->cap - b->len >= extra) return true;
-    size_t cap = b->cap ? b->cap : 4096;
-    while (cap - b->len < extra) {
-        if (cap > SIZE_MAX / 2 / b->size) return false;
-        cap *= 2;
-    }
-    void *p = realloc(b->data, cap * b->size);
-    if (!p) return false;
-    b->data = p;
-    b->cap = cap;
-    return true;
-}
 
 static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
 
@@ -367,14 +346,8 @@ static bool ply_value(PlyReader *r, PlyType t, double *out)
 
 static bool ply_triangle(PlyReader *r, uint32_t a, uint32_t b, uint32_t c)
 {
-    if (r->idx.len / 3 >= INT_MAX) return ply_fail(r, "too many triangles (limit %d)", INT_MAX);
-    if (!buf_reserve(&r->idx, 3)) return ply_fail(r, "out of memory");
-    uint32_t *t = (uint32_t *)r->idx.data + r->idx.len;
-    t[0] = a;
-    t[1] = b;
-    t[2] = c;
-    r->idx.len += 3;
-    return true;
+    const char *why = mb_add_triangle(&r->mb, a, b, c);
+    return !why || ply_fail(r, "%s", why);
 }
 
 /* The n indices of one face, fan-triangulated around the first. */
@@ -412,7 +385,7 @@ static bool ply_scalar(PlyReader *r, const PlyProperty *p)
     if (!ply_value(r, p->type, &v)) return false;
     if (p->role == ROLE_SKIP) return true;
     if (!(fabs(v) <= FLT_MAX)) return ply_fail(r, "coordinate '%s' is not finite (%g)", p->name, v);
-    vec3 *pos = (vec3 *)r->pos.data + r->pos.len - 1;
+    vec3 *pos = &r->mb.pos[r->mb.num_pos - 1];
     float f = (float)v;
     if (p->role == ROLE_X) pos->x = f;
     else if (p->role == ROLE_Y) pos->y = f;
@@ -434,8 +407,8 @@ static bool ply_record(PlyReader *r, const PlyElement *el)
 {
     if (r->format == PLY_ASCII && !ply_ascii_begin(r)) return false;
     if (el == r->vertex) {
-        if (!buf_reserve(&r->pos, 1)) return ply_fail(r, "out of memory");
-        ((vec3 *)r->pos.data)[r->pos.len++] = v3(0, 0, 0);
+        const char *why = mb_add_vertex(&r->mb, v3(0, 0, 0));
+        if (why) return ply_fail(r, "%s", why);
     }
     for (int i = 0; i < el->num_props; i++) {
         const PlyProperty *p = &el->props[i];
@@ -471,16 +444,6 @@ static bool ply_body(PlyReader *r)
     return ply_trailing(r);
 }
 
-static bool ply_finish(PlyReader *r, Mesh *mesh)
-{
-    if (!mesh_alloc(mesh, (int)r->pos.len, (int)(r->idx.len / 3), r->err))
-        return error_prefix(r->err, "%s: ", r->path);
-    memcpy(mesh->positions, r->pos.data, r->pos.len * sizeof(vec3));
-    memcpy(mesh->indices, r->idx.data, r->idx.len * sizeof(uint32_t));
-    mesh_compute_normals(mesh);
-    return true;
-}
-
 bool mesh_load_ply(const char *path, Mesh *mesh, Error *err)
 {
     memset(mesh, 0, sizeof *mesh);
@@ -496,11 +459,8 @@ bool mesh_load_ply(const char *path, Mesh *mesh, Error *err)
     r->err = err;
     r->p = buf;
     r->end = buf + size;
-    r->pos.size = sizeof(vec3);
-    r->idx.size = sizeof(uint32_t);
-    bool ok = ply_header(r) && ply_body(r) && ply_finish(r, mesh);
-    free(r->pos.data);
-    free(r->idx.data);
+    bool ok = ply_header(r) && ply_body(r) && mb_finish(&r->mb, path, mesh, err);
+    mb_free(&r->mb);
     free(r);
     free(buf);
     return ok;
