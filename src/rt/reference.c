@@ -57,7 +57,12 @@ static void fill_batch(Batch *b, const Light *l, vec3 org, vec3 p, uint32_t stre
     for (int k = 0; k < PACKET; k++) {
         int i = first + k;
         b->valid[k] = i < count ? -1 : 0;
-        if (i >= count) continue;
+        if (i >= count) { /* Embree reads every lane: keep unused ones finite and empty */
+            b->ray.org_x[k] = b->ray.org_y[k] = b->ray.org_z[k] = 0.0f;
+            b->ray.dir_x[k] = b->ray.dir_y[k] = 0.0f; b->ray.dir_z[k] = 1.0f;
+            b->ray.tnear[k] = b->ray.tfar[k] = b->ray.time[k] = 0.0f;
+            continue;
+        }
         float u, v;
         sample_2d(prm->pattern, stream, i, count, &u, &v);
         LightSample *s = &b->ls[k];
@@ -73,19 +78,33 @@ static void fill_batch(Batch *b, const Light *l, vec3 org, vec3 p, uint32_t stre
     }
 }
 
-static void accumulate(Accum *a, const Batch *b, vec3 n_shading, vec3 albedo)
+/* Visibility sums of the `nc` channels the reference stores. */
+static void accumulate_visibility(Accum *a, const Batch *b, int nc)
 {
     for (int k = 0; k < PACKET; k++) {
         if (!b->valid[k]) continue;
         const LightSample *s = &b->ls[k];
         float vis = b->ray.tfar[k] == -INFINITY ? 0.0f : 1.0f; /* Embree marks occluded rays with tfar = -inf */
-        float cos_p = fmaxf(0.0f, v3_dot(n_shading, s->dir_world));
         const float w[3] = {s->vis_weight.x, s->vis_weight.y, s->vis_weight.z};
-        const float e[3] = {s->irradiance.x * albedo.x, s->irradiance.y * albedo.y, s->irradiance.z * albedo.z};
-        for (int c = 0; c < 3; c++) {
+        for (int c = 0; c < nc; c++) {
             a->w[c] += w[c];
             a->wv[c] += w[c] * vis;
             a->w2[c] += (double)w[c] * w[c];
+        }
+        a->n++;
+    }
+}
+
+/* Lambertian direct illumination, course Eq. 1.3: E cos / pi per sample. */
+static void accumulate_irradiance(Accum *a, const Batch *b, vec3 n_shading, vec3 albedo)
+{
+    for (int k = 0; k < PACKET; k++) {
+        if (!b->valid[k]) continue;
+        const LightSample *s = &b->ls[k];
+        float vis = b->ray.tfar[k] == -INFINITY ? 0.0f : 1.0f;
+        float cos_p = fmaxf(0.0f, v3_dot(n_shading, s->dir_world));
+        const float e[3] = {s->irradiance.x * albedo.x, s->irradiance.y * albedo.y, s->irradiance.z * albedo.z};
+        for (int c = 0; c < 3; c++) {
             double contrib = e[c] * cos_p * vis * INV_PI;
             a->c[c] += contrib;
             a->c2[c] += contrib * contrib;
@@ -136,13 +155,15 @@ static void trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx
     vec3 p = j->vs->p_world[s], ng = j->vs->n_geom_world[s];
     vec3 org = v3_madd(p, ng, rt_ray_offset(j->extent, p));
     uint32_t stream = sampling_stream(j->p->seed, (uint32_t)s);
+    int nc = j->out->value.channels;
     Accum a = {0};
     for (int first = 0; first < j->count; first += PACKET) {
         fill_batch(b, j->light, org, p, stream, first, j->count, j->p);
         rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
-        accumulate(&a, b, j->vs->n_shading_world[s], j->scene->objects[j->vs->object[s]].albedo);
+        if (j->p->measure == MEASURE_IRRADIANCE)
+            accumulate_irradiance(&a, b, j->vs->n_shading_world[s], j->scene->objects[j->vs->object[s]].albedo);
+        else accumulate_visibility(&a, b, nc);
     }
-    int nc = j->out->value.channels;
     float *v = j->out->value.data + (size_t)s * nc, *se = j->out->std_error.data + (size_t)s * nc;
     if (j->p->measure == MEASURE_IRRADIANCE) finish_irradiance(&a, v, se);
     else finish_visibility(&a, v, se, nc);

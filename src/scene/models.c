@@ -80,18 +80,20 @@ static bool find_file(const SceneLoadCtx *ctx, const char *name, char *out, size
     return false;
 }
 
-bool scene_load_model(const SceneLoadCtx *ctx, const char *const *names, int n, Object *o, Error *err)
+bool scene_load_model(const SceneLoadCtx *ctx, const ModelChoice *choices, int n, Object *o, Error *err)
 {
     char path[SCENE_PATH_MAX];
     for (int i = 0; i < n; i++) {
-        if (!find_file(ctx, names[i], path, sizeof path)) continue;
+        if (!find_file(ctx, choices[i].name, path, sizeof path)) continue;
         snprintf(o->source, sizeof o->source, "%s", path);
-        return mesh_load(path, &o->mesh, err);
+        if (!mesh_load(path, &o->mesh, err)) return false;
+        mesh_transform(&o->mesh, &choices[i].pre);
+        return true;
     }
     char where[4096], tried[1024] = "";
     scene_model_path(ctx, where, sizeof where);
     for (int i = 0, used = 0; i < n && used < (int)sizeof tried - 2; i++)
-        used += snprintf(tried + used, sizeof tried - (size_t)used, "%s%s", i ? ", " : "", names[i]);
+        used += snprintf(tried + used, sizeof tried - (size_t)used, "%s%s", i ? ", " : "", choices[i].name);
     return error_set(err, "model not found: %s (searched %s; set SHADOWLAB_MODEL_PATH)", tried, where);
 }
 

@@ -13,8 +13,17 @@ typedef struct SceneLoadCtx {
 } SceneLoadCtx;
 
 bool scene_read_table(lua_State *L, int idx, const SceneLoadCtx *ctx, Scene *scene, Error *err);
-/* Find the first of `names` on the model search path and load it. */
-bool scene_load_model(const SceneLoadCtx *ctx, const char *const *names, int n, Object *o, Error *err);
+/* One alternative file for a model, with the transform that maps it into the
+ * frame of the scene's first alternative. */
+#define MODEL_MAX_CHOICES 16
+typedef struct ModelChoice {
+    char name[SCENE_PATH_MAX];
+    mat34 pre;
+} ModelChoice;
+
+/* Find the first of `choices` on the model search path, load it and apply its
+ * pre-transform; the object's source records which file was used. */
+bool scene_load_model(const SceneLoadCtx *ctx, const ModelChoice *choices, int n, Object *o, Error *err);
 bool scene_load_light_image(const SceneLoadCtx *ctx, const char *name, Light *l, Error *err);
 /* Model search path as one string, for messages and docs. */
 void scene_model_path(const SceneLoadCtx *ctx, char *out, size_t n);

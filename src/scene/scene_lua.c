@@ -200,20 +200,58 @@ static bool build_heightfield(LuaReader *r, int idx, Mesh *m, const SceneLoadCtx
     return ok || rd_fail(r, NULL, ": %s", r->err->msg);
 }
 
-/* Model file name(s): a string, or a list of alternatives tried in order. */
+/* One alternative of `model`: a file name, or {file = NAME, scale = k,
+ * translate = {x, y, z}} whose transform maps that file into the frame of
+ * the first alternative (two scans of one object stored at different scales). */
+static bool read_model_choice(LuaReader *r, int idx, ModelChoice *c)
+{
+    static const char *const keys[] = {"file", "scale", "translate", NULL};
+    lua_State *L = r->L;
+    c->pre = m34_identity();
+    if (lua_type(L, idx) == LUA_TSTRING) {
+        snprintf(c->name, sizeof c->name, "%s", lua_tostring(L, idx));
+        return true;
+    }
+    if (!lua_istable(L, idx)) return rd_fail(r, NULL, "must be a file name or {file = ..., scale = ..., translate = ...}");
+    double k;
+    vec3 t;
+    if (!rd_only_keys(r, idx, keys) || !rd_string(r, idx, "file", "", c->name, sizeof c->name) ||
+        !rd_number(r, idx, "scale", POS_LENGTH, false, 1, &k) ||
+        !rd_vec3(r, idx, "translate", ANY_COORD, false, v3(0, 0, 0), &t))
+        return false;
+    if (!c->name[0]) return rd_fail(r, "file", "is missing (a .obj or .ply file name)");
+    c->pre = transform_srt(v3((float)k, (float)k, (float)k), v3(0, 0, 0), t);
+    return true;
+}
+
+/* `model`: one alternative, or a list of them tried in order. */
 static bool build_model(LuaReader *r, int idx, Object *o, const SceneLoadCtx *ctx)
 {
     lua_State *L = r->L;
     if (!rd_get(r, idx, "model")) return rd_fail(r, "model", "is missing (a .obj or .ply file name)");
-    const char *names[16];
-    int n = 0;
-    if (lua_type(L, -1) == LUA_TSTRING) names[n++] = lua_tostring(L, -1);
-    else if (lua_istable(L, -1))
-        for (int i = 1; n < 16 && lua_rawgeti(L, -1, i) == LUA_TSTRING; i++) names[n++] = lua_tostring(L, -1);
-    bool ok = n > 0 ? scene_load_model(ctx, names, n, o, r->err)
-                    : rd_fail(r, "model", "must be a file name or a list of file names");
-    if (n > 0 && !ok) rd_fail(r, "model", ": %s", r->err->msg);
+    ModelChoice choices[MODEL_MAX_CHOICES];
+    int n = 0, list = lua_gettop(L);
+    size_t saved = rd_enter_key(r, "model");
+    bool ok = true;
+    if (lua_type(L, list) == LUA_TSTRING || (lua_istable(L, list) && rd_get(r, list, "file"))) {
+        lua_settop(L, list);
+        ok = read_model_choice(r, list, &choices[n++]);
+    } else if (lua_istable(L, list)) {
+        int len = (int)luaL_len(L, list);
+        if (len < 1 || len > MODEL_MAX_CHOICES) ok = rd_fail(r, NULL, "has %d alternatives, expected 1 to %d", len, MODEL_MAX_CHOICES);
+        for (int i = 1; ok && i <= len; i++) {
+            size_t inner = rd_enter_index(r, i);
+            lua_rawgeti(L, list, i);
+            ok = read_model_choice(r, lua_gettop(L), &choices[n++]);
+            lua_settop(L, list);
+            rd_leave(r, inner);
+        }
+    } else {
+        ok = rd_fail(r, NULL, "must be a file name or a list of alternatives");
+    }
+    rd_leave(r, saved);
     lua_settop(L, idx);
+    if (ok && !scene_load_model(ctx, choices, n, o, r->err)) ok = rd_fail(r, "model", ": %s", r->err->msg);
     return ok;
 }
 

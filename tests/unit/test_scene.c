@@ -105,3 +105,27 @@ TEST(test_scene_heightfield_and_procedural_loops)
     scene_free(&a);
     scene_free(&b);
 }
+
+/* A model named by alternatives: the first file found is used, with its own
+ * scale and translate mapping it into the first alternative's frame. */
+TEST(test_scene_model_alternatives_and_their_transforms)
+{
+    fixture_file("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n");
+    const char *text =
+        "return { camera = { position = {0, 3, 6}, target = {0, 0, 0} },\n"
+        "  lights = { { type = 'point', position = {0, 4, 0} } },\n"
+        "  objects = { { shape = 'mesh', translate = {0, 1, 0},\n"
+        "    model = { 'absent.obj', 'absent2.ply', { file = 'tri.obj', scale = 2, translate = {5, 0, 0} } } } } }\n";
+    Scene sc;
+    Error err;
+    CHECK_MSG(load(text, NULL, 0, &sc, &err), "%s", err.msg);
+    CHECK(strstr(sc.objects[0].source, "tri.obj") != NULL);
+    vec3 p = sc.objects[0].mesh.positions[1]; /* (1,0,0) -> x2 -> +5 in x -> +1 in y */
+    CHECK_NEAR(p.x, 7, 1e-6);
+    CHECK_NEAR(p.y, 1, 1e-6);
+    scene_free(&sc);
+    expect_error(text, "objects[1].model={'absent.obj'}", "model not found", "absent.obj");
+    expect_error(text, "objects[1].model={{file='tri.obj', scale=-1}}", "objects[1].model[1].scale", NULL);
+    expect_error(text, "objects[1].model={{scale=2}}", "objects[1].model[1].file", "missing");
+    expect_error(text, "objects[1].model=3", "objects[1].model", "file name");
+}
