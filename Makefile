@@ -7,13 +7,14 @@ CXX     ?= c++
 OPT     ?= -O2
 # snprintf into bounded buffers truncates by design: that warning is off.
 WARN    := -Wall -Wextra -Werror -Wno-format-truncation
-INCS    := -Isrc -Ibuild/gen -I/usr/include/lua5.4 -I/usr/include/OpenEXR
-CFLAGS  := -std=c11 $(OPT) -g $(WARN) -fopenmp -fPIC $(INCS) -D_DEFAULT_SOURCE
+INCS     = -Isrc -I$(B)/gen -I/usr/include/lua5.4 -I/usr/include/OpenEXR
+CFLAGS   = -std=c11 $(OPT) -g $(WARN) -fopenmp -fPIC $(INCS) -D_DEFAULT_SOURCE
 # Embree 3 and OpenEXRCore have no usable pkg-config entry for C: link by name.
 LIBS    := -llua5.4 -lembree3 -lOpenEXRCore-3_1 -lz -ldl -lm -fopenmp
 SAN     := -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
 
-B       := build
+# Build folder; several working copies of one checkout can use their own (make B=build-x).
+B       ?= build
 DEPS    := $(B)/deps.stamp
 LIB_SRC := $(shell find src -name '*.c' ! -path 'src/cli/main.c' | sort)
 LIB_OBJ := $(LIB_SRC:%.c=$(B)/obj/%.o)
@@ -64,7 +65,7 @@ $(B)/test_unit_san: $(TEST_SAN) $(SAN_OBJ)
 
 # Unit tests once under ASan+UBSan, then the CLI tests on the optimised build.
 test: all $(B)/test_unit_san
-	@./tests/run.sh
+	@B=$(B) ./tests/run.sh
 test-unit: all $(B)/test_unit
 	SHADOWLAB_MODEL_PATH=$${SHADOWLAB_MODEL_PATH:-../shared/models} SHADOWLAB_PLUGIN_DIR=$(CURDIR)/$(B) ./$(B)/test_unit $(T)
 

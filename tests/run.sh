@@ -4,17 +4,18 @@
 # total as "N passed, N failed"; exits non-zero on any failure.
 set -u -o pipefail
 cd "$(dirname "$0")/.."
+B=${B:-build} # the build folder (Makefile: B)
 : "${SHADOWLAB_MODEL_PATH:=$(pwd)/../shared/models}"
 export SHADOWLAB_MODEL_PATH
-export SHADOWLAB_PLUGIN_DIR="$(pwd)/build"
+export SHADOWLAB_PLUGIN_DIR="$(pwd)/$B"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 export LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0"
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
-./build/test_unit_san 2>&1 | tee "$log"
+"./$B/test_unit_san" 2>&1 | tee "$log"
 unit_status=$?
-SHADOWLAB_CACHE=$(mktemp -d) ./tests/cli/run.sh build/shadowlab 2>&1 | tee -a "$log"
+SHADOWLAB_CACHE=$(mktemp -d) ./tests/cli/run.sh "$B/shadowlab" 2>&1 | tee -a "$log"
 passed=$(sed -n 's/^[a-z]*: \([0-9]*\) passed, \([0-9]*\) failed$/\1/p' "$log" | awk '{s+=$1} END {print s+0}')
 failed=$(sed -n 's/^[a-z]*: \([0-9]*\) passed, \([0-9]*\) failed$/\2/p' "$log" | awk '{s+=$1} END {print s+0}')
 suites=$(grep -c '^[a-z]*: [0-9]* passed, [0-9]* failed$' "$log")
