@@ -8,7 +8,9 @@ static void print_text(void)
 {
     for (int i = 0; i < tech_count(); i++) {
         const Technique *t = tech_at(i);
-        printf("%s  [%s; %s]\n  %s\n", t->name, t->family, t->source, t->summary);
+        char lights[160];
+        tech_lights_text(t, lights, sizeof lights);
+        printf("%s  [%s; %s]\n  %s\n  lights: %s\n", t->name, t->family, t->source, t->summary, lights);
         printf("  resources:");
         for (const char *const *r = t->resources; *r; r++) printf(" %s", *r);
         printf("\n");
@@ -31,8 +33,10 @@ static void print_markdown(void)
            "(src/techniques/registry.c); do not edit.\n");
     for (int i = 0; i < tech_count(); i++) {
         const Technique *t = tech_at(i);
-        printf("\n## `%s`\n\n%s\n\n- family: %s\n- source: %s\n- output: %s\n- resources:", t->name, t->summary,
-               t->family, t->source, t->rgb ? "visibility, RGB for textured lights" : "visibility");
+        char lights[160];
+        tech_lights_text(t, lights, sizeof lights);
+        printf("\n## `%s`\n\n%s\n\n- family: %s\n- source: %s\n- lights: %s\n- output: %s\n- resources:", t->name,
+               t->summary, t->family, t->source, lights, t->rgb ? "visibility, RGB for textured lights" : "visibility");
         for (const char *const *r = t->resources; *r; r++) printf(" `%s`", *r);
         printf("\n\n| parameter | type | default | range | unit | meaning |\n|---|---|---|---|---|---|\n");
         for (int k = 0; k < t->num_params; k++) {
@@ -58,6 +62,10 @@ static void print_json(void)
         json_string(&w, "source", t->source);
         json_string(&w, "summary", t->summary);
         json_bool(&w, "rgb", t->rgb);
+        json_array_begin(&w, "lights");
+        for (int k = LIGHT_POINT; k <= LIGHT_TEXTURED_RECT; k++)
+            if (t->lights & LIGHT_BIT(k)) json_string(&w, NULL, light_kind_name((LightKind)k));
+        json_array_end(&w);
         json_array_begin(&w, "resources");
         for (const char *const *r = t->resources; *r; r++) json_string(&w, NULL, *r);
         json_array_end(&w);

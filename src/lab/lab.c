@@ -104,6 +104,7 @@ bool lab_render(Lab *lab, const RenderRequest *req, RenderResult *out, Error *er
     memset(out, 0, sizeof *out);
     const Scene *sc = &lab->scene;
     if (req->repeat < 1 || req->repeat > 10000) return error_set(err, "--repeat %d outside [1, 10000]", req->repeat);
+    if (!tech_check_light(req->tech, &sc->lights[req->light_index], req->light_index + 1, err)) return false;
     double t0 = timer_now_s();
     const ViewSamples *vs = res_view_samples(lab->rm, sc, err);
     const uint8_t *cls = vs ? res_classes(lab->rm, sc, req->light_index, err) : NULL;

@@ -63,6 +63,7 @@ const Technique tech_hard = {
     .num_params = (int)(sizeof hard_params / sizeof hard_params[0]),
     .resources = hard_resources,
     .rgb = true,
+    .lights = LIGHTS_ALL,
     .prepare = hard_prepare,
     .evaluate = hard_evaluate,
     .release = free,

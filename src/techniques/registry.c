@@ -33,6 +33,24 @@ const char *param_type_name(ParamType t)
     return names[t];
 }
 
+void tech_lights_text(const Technique *t, char *out, size_t n)
+{
+    size_t used = 0;
+    out[0] = '\0';
+    for (int k = LIGHT_POINT; k <= LIGHT_TEXTURED_RECT && used < n; k++)
+        if (t->lights & LIGHT_BIT(k))
+            used += (size_t)snprintf(out + used, n - used, "%s%s", used ? ", " : "", light_kind_name((LightKind)k));
+}
+
+bool tech_check_light(const Technique *t, const Light *light, int light_number, Error *err)
+{
+    if (t->lights & LIGHT_BIT(light->kind)) return true;
+    char kinds[160];
+    tech_lights_text(t, kinds, sizeof kinds);
+    return error_set(err, "%s handles %s lights; light %d is a %s light", t->name, kinds, light_number,
+                     light_kind_name(light->kind));
+}
+
 void tech_params_default(const Technique *t, double *values)
 {
     for (int i = 0; i < t->num_params; i++) values[i] = t->params[i].def;

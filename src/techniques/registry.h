@@ -24,5 +24,9 @@ void tech_param_format(const ParamDesc *p, double value, char *out, size_t n);
 /* The valid range as text: "[1, 64]", "one of: a, b", "true or false". */
 void tech_param_range(const ParamDesc *p, char *out, size_t n);
 const char *param_type_name(ParamType t);
+/* The technique's light kinds as text ("point, spot, sphere"). */
+void tech_lights_text(const Technique *t, char *out, size_t n);
+/* Refuse a light the technique does not handle, naming what it handles. */
+bool tech_check_light(const Technique *t, const Light *light, int light_number, Error *err);
 
 #endif

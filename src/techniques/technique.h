@@ -23,6 +23,13 @@ typedef struct ParamDesc {
 
 #define TECH_MAX_PARAMS 32
 
+/* Light kinds a technique handles, as a bit set of LightKind. */
+#define LIGHT_BIT(kind) (1u << (kind))
+#define LIGHTS_DELTA (LIGHT_BIT(LIGHT_POINT) | LIGHT_BIT(LIGHT_SPOT) | LIGHT_BIT(LIGHT_DIRECTIONAL))
+#define LIGHTS_AREA \
+    (LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_TEXTURED_RECT))
+#define LIGHTS_ALL (LIGHTS_DELTA | LIGHTS_AREA)
+
 /* Everything an evaluation may read. Samples whose class is not
  * SAMPLE_LIT_CANDIDATE may be skipped: the engine overwrites them. */
 typedef struct TechContext {
@@ -45,6 +52,7 @@ typedef struct Technique {
     int num_params;
     const char *const *resources;/* resource kinds it may acquire, NULL-terminated */
     bool rgb;                    /* evaluates 3 channels when ctx->channels == 3 */
+    unsigned lights;             /* LIGHT_BIT set of the light kinds it handles; others are refused */
     /* Acquire resources and build per-run state (may be NULL on success). */
     bool (*prepare)(const TechContext *ctx, void **state, Error *err);
     /* Visibility of samples [begin, end) into out[(s - begin) * channels + c];

@@ -13,6 +13,7 @@ TEST(test_registry_declarations_are_complete)
         CHECK_MSG(t->name && t->family && t->source && t->summary && t->resources, "technique %d", i);
         CHECK_MSG(t->prepare && t->evaluate, "%s: no prepare/evaluate", t->name);
         CHECK(t->num_params <= TECH_MAX_PARAMS);
+        CHECK_MSG(t->lights != 0 && (t->lights & ~LIGHTS_ALL) == 0, "%s: light kinds %#x", t->name, t->lights);
         Error err;
         CHECK_MSG(tech_find(t->name, &err) == t, "%s is not found by name", t->name);
         for (int j = 0; j < i; j++) CHECK_MSG(strcmp(tech_at(j)->name, t->name) != 0, "duplicate %s", t->name);
