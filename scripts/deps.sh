@@ -4,7 +4,8 @@
 # Uses sudo when not root; fails with a clear message when it cannot install.
 set -u
 PACKAGES="build-essential pkg-config liblua5.4-dev lua5.4 libembree-dev libopenexr-dev \
-libopenimageio-dev zlib1g-dev gnuplot-nox glmark2-data"
+libopenimageio-dev zlib1g-dev gnuplot-nox glmark2-data \
+chromium parallel"
 
 missing=""
 for p in $PACKAGES; do
