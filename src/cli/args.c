@@ -35,6 +35,7 @@ static bool parse_option(char **argv, int *i, int argc, CliOptions *o, Error *er
     else if (is(a, "-o", "--out")) o->out_dir = v;
     else if (is(a, "--threads", NULL)) ok = parse_int(a, v, 1, 1024, &o->threads, err);
     else if (is(a, "--repeat", NULL)) ok = parse_int(a, v, 1, 10000, &o->repeat, err);
+    else if (is(a, "--warmup", NULL)) ok = parse_int(a, v, 0, 1000, &o->warmup, err);
     else if (is(a, "--light", "-l")) ok = parse_int(a, v, 1, 64, &o->light, err);
     else if (is(a, "--samples", "-n")) ok = parse_int(a, v, 1, REFERENCE_MAX_SAMPLES, &o->ref.samples, err);
     else if (is(a, "--seed", NULL)) {

@@ -18,6 +18,7 @@ typedef struct CliOptions {
     int num_overrides;
     const char *out_dir;
     int threads, repeat, light;
+    int warmup;            /* untimed evaluations before the timed ones */
     ReferenceParams ref;
     const char *cache_dir; /* NULL: default */
     bool no_cache, no_png, json, names, markdown, help;

@@ -1,10 +1,10 @@
-/* run.c -- `render`, `reference` and `compare`: one pipeline, three subsets
- * of its stages (render: technique; reference: ground truth; compare: both,
- * then metrics), then the outputs and the printed table. */
+/* run.c -- `render`, `reference` and `compare`: one pipeline (lab/compare.h),
+ * three subsets of its stages (render: technique; reference: ground truth;
+ * compare: both, then metrics), then the outputs and the printed table. */
 #include <omp.h>
 #include <string.h>
 #include "cli/cli.h"
-#include "core/timer.h"
+#include "lab/compare.h"
 #include "resources/refcache.h"
 
 enum Stage { STAGE_RENDER = 1, STAGE_REFERENCE = 2 };
@@ -22,6 +22,7 @@ static const char *const help_text =
     "  --cache DIR            reference cache folder (default $SHADOWLAB_CACHE or ~/.cache/shadowlab)\n"
     "  --no-cache             neither read nor write the reference cache\n"
     "  --repeat N             time N evaluations; median and minimum reported\n"
+    "  --warmup N             untimed evaluations before the timed ones (default 0)\n"
     "  --threads N            worker threads (default: all cores)\n"
     "  -o, --out DIR          output folder (default reports/SCENE-NAME)\n"
     "  --no-png               skip the PNG previews\n";
@@ -29,14 +30,9 @@ static const char *const help_text =
 typedef struct Job {
     CliOptions o;
     Lab *lab;
-    const Technique *tech;
+    CompareRequest req;
     double params[TECH_MAX_PARAMS];
-    int light_index;
-    RenderResult render;
-    const Reference *ref;
-    RefInfo ref_info;
-    Metrics metrics;
-    Image signed_error;
+    CompareResult result;
     char cache_dir[1024];
     char out_dir[1024];
 } Job;
@@ -44,16 +40,17 @@ typedef struct Job {
 static bool setup(Job *j, int stages, Error *err)
 {
     const CliOptions *o = &j->o;
-    if ((stages & STAGE_RENDER) && !o->technique) return error_set(err, "missing -t TECHNIQUE (see shadowlab list)");
-    if (stages & STAGE_RENDER) {
-        j->tech = tech_find(o->technique, err);
-        if (!j->tech) return false;
-        tech_params_default(j->tech, j->params);
-        for (int i = 0; i < o->num_params; i++)
-            if (!tech_param_parse(j->tech, o->params[i], j->params, err)) return false;
-    }
+    j->req = (CompareRequest){NULL, j->params, 0, o->repeat, o->warmup, (stages & STAGE_REFERENCE) != 0, o->ref,
+                              NULL};
+    if (!(stages & STAGE_RENDER)) return reference_params_check(&o->ref, err);
+    if (!o->technique) return error_set(err, "missing -t TECHNIQUE (see shadowlab list)");
+    j->req.tech = tech_find(o->technique, err);
+    if (!j->req.tech) return false;
+    tech_params_default(j->req.tech, j->params);
+    for (int i = 0; i < o->num_params; i++)
+        if (!tech_param_parse(j->req.tech, o->params[i], j->params, err)) return false;
     if ((stages & STAGE_REFERENCE) && !reference_params_check(&o->ref, err)) return false;
-    if ((stages & STAGE_RENDER) && o->ref.measure != MEASURE_VISIBILITY)
+    if (o->ref.measure != MEASURE_VISIBILITY)
         return error_set(err, "--measure irradiance is for `shadowlab reference`; techniques estimate visibility");
     return true;
 }
@@ -67,31 +64,8 @@ static bool load(Job *j, Error *err)
     else snprintf(j->out_dir, sizeof j->out_dir, "reports/%s", sc->name);
     if (j->o.cache_dir) snprintf(j->cache_dir, sizeof j->cache_dir, "%s", j->o.cache_dir);
     else refcache_default_dir(j->cache_dir, sizeof j->cache_dir);
-    return lab_light_index(j->lab, j->o.light, &j->light_index, err);
-}
-
-static bool run_stages(Job *j, int stages, double *metrics_s, Error *err)
-{
-    if (stages & STAGE_RENDER) {
-        RenderRequest req = {j->tech, j->params, j->light_index, j->o.repeat};
-        if (!lab_render(j->lab, &req, &j->render, err)) return false;
-    }
-    if (stages & STAGE_REFERENCE) {
-        RefRequest rq = {j->light_index, j->o.ref, j->o.no_cache ? NULL : j->cache_dir};
-        j->ref = res_reference(lab_resources(j->lab), lab_scene(j->lab), &rq, &j->ref_info, err);
-        if (!j->ref) return false;
-        if (j->ref_info.cache_note[0]) fprintf(stderr, "shadowlab: warning: %s\n", j->ref_info.cache_note);
-    }
-    if (stages == (STAGE_RENDER | STAGE_REFERENCE)) {
-        double t0 = timer_now_s();
-        const uint8_t *cls = res_classes(lab_resources(j->lab), lab_scene(j->lab), j->light_index, err);
-        const Image *v = &j->render.visibility;
-        if (!cls || !image_init(&j->signed_error, v->width, v->height, v->channels, err) ||
-            !metrics_compute(v, j->ref, cls, &j->metrics, &j->signed_error, err))
-            return false;
-        *metrics_s = timer_now_s() - t0;
-    }
-    return true;
+    j->req.cache_dir = j->o.no_cache ? NULL : j->cache_dir;
+    return lab_light_index(j->lab, j->o.light, &j->req.light_index, err);
 }
 
 static int run(const char *name, int stages, int argc, char **argv)
@@ -108,16 +82,10 @@ static int run(const char *name, int stages, int argc, char **argv)
         return EXIT_OK;
     }
     cli_apply_threads(&j.o);
-    double metrics_s = 0;
     int status = EXIT_RUNTIME;
-    if (load(&j, &err) && run_stages(&j, stages, &metrics_s, &err)) {
-        RunReport rep = {name, j.lab, j.light_index, j.tech, j.params, (stages & STAGE_RENDER) ? &j.render : NULL,
-                         j.ref, &j.ref_info, NULL, NULL, 0, metrics_s, 0, omp_get_max_threads()};
-        if (stages == (STAGE_RENDER | STAGE_REFERENCE)) {
-            rep.metrics = &j.metrics;
-            rep.signed_error = &j.signed_error;
-            rep.error_scale = report_error_scale(j.metrics.region[REGION_ALL].max_abs);
-        }
+    if (load(&j, &err) && lab_compare(j.lab, &j.req, &j.result, &err)) {
+        if (j.result.ref_info.cache_note[0]) fprintf(stderr, "shadowlab: warning: %s\n", j.result.ref_info.cache_note);
+        RunReport rep = compare_report(j.lab, &j.result, name, omp_get_max_threads());
         if (report_write_all(&rep, j.out_dir, !j.o.no_png, &err)) {
             report_print(&rep, stdout);
             printf("outputs: %s/%s.{exr,json%s}\n", j.out_dir, report_stem(&rep), j.o.no_png ? "" : ",png");
@@ -125,8 +93,7 @@ static int run(const char *name, int stages, int argc, char **argv)
         }
     }
     if (status != EXIT_OK) fprintf(stderr, "shadowlab %s: %s\n", name, err.msg);
-    image_free(&j.signed_error);
-    render_result_free(&j.render);
+    compare_result_free(&j.result);
     lab_close(j.lab);
     return status;
 }

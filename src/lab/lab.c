@@ -3,6 +3,7 @@
  * evaluations in parallel over rows. Samples that are not lit candidates get
  * the reference's convention (0, or 1 on non-receivers) after evaluation. */
 #include "lab/lab.h"
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/timer.h"
@@ -86,10 +87,12 @@ static void finish_image(Image *img, int tech_channels, const uint8_t *cls)
     }
 }
 
-static bool run_evaluations(const RenderRequest *req, const void *state, const TechContext *ctx, RenderResult *out)
+static bool run_evaluations(const RenderRequest *req, int warmup, const void *state, const TechContext *ctx,
+                            RenderResult *out)
 {
     double *times = malloc(sizeof(double) * (size_t)req->repeat);
     if (!times) return false;
+    for (int i = 0; i < warmup; i++) evaluate_all(req->tech, state, ctx, &out->visibility);
     for (int i = 0; i < req->repeat; i++) times[i] = evaluate_all(req->tech, state, ctx, &out->visibility);
     qsort(times, (size_t)req->repeat, sizeof(double), cmp_double);
     out->eval_min_s = times[0];
@@ -99,11 +102,31 @@ static bool run_evaluations(const RenderRequest *req, const void *state, const T
     return true;
 }
 
+/* The prepare's scope: its resources and their summed own build times. */
+static double collect_tech_resources(const ResourceManager *rm, RenderResult *out, double *built_s)
+{
+    double total = 0;
+    *built_s = 0;
+    for (int i = 0; i < rm_scope_count(rm); i++) {
+        const ResourceEvent *ev = rm_scope_event(rm, i);
+        total += ev->own_s;
+        if (ev->built) *built_s += ev->own_s;
+        if (i < RENDER_MAX_TECH_RESOURCES) out->tech_resources[out->num_tech_resources++] = *ev;
+    }
+    return total;
+}
+
 bool lab_render(Lab *lab, const RenderRequest *req, RenderResult *out, Error *err)
+{
+    return lab_render_warm(lab, req, 0, out, err);
+}
+
+bool lab_render_warm(Lab *lab, const RenderRequest *req, int warmup, RenderResult *out, Error *err)
 {
     memset(out, 0, sizeof *out);
     const Scene *sc = &lab->scene;
     if (req->repeat < 1 || req->repeat > 10000) return error_set(err, "--repeat %d outside [1, 10000]", req->repeat);
+    if (warmup < 0 || warmup > 1000) return error_set(err, "--warmup %d outside [0, 1000]", warmup);
     if (!tech_check_light(req->tech, &sc->lights[req->light_index], req->light_index + 1, err)) return false;
     double t0 = timer_now_s();
     const ViewSamples *vs = res_view_samples(lab->rm, sc, err);
@@ -115,14 +138,21 @@ bool lab_render(Lab *lab, const RenderRequest *req, RenderResult *out, Error *er
                        req->tech->rgb ? ref_channels : 1};
     if (!image_init(&out->visibility, vs->width, vs->height, ref_channels, err)) return false;
     void *state = NULL;
+    rm_scope_begin(lab->rm);
     t0 = timer_now_s();
-    if (!req->tech->prepare(&ctx, &state, err)) {
+    bool prepared = req->tech->prepare(&ctx, &state, err);
+    out->prepare_s = timer_now_s() - t0;
+    rm_scope_end(lab->rm);
+    if (!prepared) {
         image_free(&out->visibility);
         return error_prefix(err, "%s: ", req->tech->name);
     }
-    out->prepare_s = timer_now_s() - t0;
+    double built_s;
+    out->tech_build_s = collect_tech_resources(lab->rm, out, &built_s);
     out->repeat = req->repeat;
-    bool ok = run_evaluations(req, state, &ctx, out);
+    out->warmup = warmup;
+    bool ok = run_evaluations(req, warmup, state, &ctx, out);
+    out->frame_s = out->tech_build_s + fmax(0.0, out->prepare_s - built_s) + out->eval_median_s;
     if (req->tech->release) req->tech->release(state);
     if (!ok) {
         image_free(&out->visibility);

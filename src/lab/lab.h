@@ -26,15 +26,33 @@ typedef struct RenderRequest {
     int repeat;           /* evaluations timed; >= 1 */
 } RenderRequest;
 
+#define RENDER_MAX_TECH_RESOURCES 16
+
 typedef struct RenderResult {
     Image visibility;      /* per view sample, 1 or 3 channels */
     double view_s;         /* view samples + classes (0 when reused) */
     double prepare_s;      /* the technique's resource acquisition and set-up */
     double eval_median_s, eval_min_s;
     int repeat;
+    int warmup;
+    /* What the technique's prepare depends on (a resources.h scope: what it
+     * acquired and what those were built from; the first
+     * RENDER_MAX_TECH_RESOURCES listed, all counted in tech_build_s). */
+    ResourceEvent tech_resources[RENDER_MAX_TECH_RESOURCES];
+    int num_tech_resources;
+    double tech_build_s;   /* sum of their own build times, also when reused here */
+    /* Frame time: what one frame costs a renderer that rebuilds the
+     * technique's resources every frame (a shadow map is re-rendered each
+     * frame) = tech_build_s + the prepare's own set-up (prepare_s net of the
+     * builds inside it) + eval_median_s. It leaves out the engine's view
+     * samples and classes (a renderer's G-buffer) and the reference, and is
+     * the same whether this run built the resources or reused them. */
+    double frame_s;
 } RenderResult;
 
 bool lab_render(Lab *lab, const RenderRequest *req, RenderResult *out, Error *err);
+/* The same after `warmup` untimed evaluations (caches, page faults), in [0, 1000]. */
+bool lab_render_warm(Lab *lab, const RenderRequest *req, int warmup, RenderResult *out, Error *err);
 void render_result_free(RenderResult *r);
 
 #endif

@@ -149,6 +149,9 @@ static void write_timings(JsonWriter *w, const RunReport *r)
         json_number(w, "evaluate_median", r->render->eval_median_s);
         json_number(w, "evaluate_min", r->render->eval_min_s);
         json_int(w, "repeat", r->render->repeat);
+        json_int(w, "warmup", r->render->warmup);
+        json_number(w, "technique_build", r->render->tech_build_s);
+        json_number(w, "frame", r->render->frame_s);
     }
     if (r->ref) json_number(w, "reference", r->ref_info->seconds);
     if (r->metrics) json_number(w, "metrics", r->metrics_s);
@@ -156,32 +159,53 @@ static void write_timings(JsonWriter *w, const RunReport *r)
     json_object_end(w);
 }
 
+static void write_event(JsonWriter *w, const ResourceEvent *ev)
+{
+    char hex[17];
+    json_object_begin(w, NULL);
+    json_string(w, "kind", ev->kind);
+    json_string(w, "desc", ev->desc);
+    hash_hex(ev->key, hex);
+    json_string(w, "key", hex);
+    json_string(w, "action", ev->built ? "built" : "reused");
+    json_number(w, "build_s", ev->build_s);
+    json_number(w, "own_build_s", ev->own_s);
+    json_int(w, "bytes", (long long)ev->bytes);
+    json_object_end(w);
+}
+
+/* The run's resource log; what the technique's prepare depends on (its
+ * frame time counts their own build times); cold when anything was built. */
 static void write_resources(JsonWriter *w, const RunReport *r)
 {
     const ResourceManager *rm = lab_resources(r->lab);
-    char hex[17];
+    bool any_built = false;
     json_array_begin(w, "resources");
     for (int i = 0; i < rm_log_count(rm); i++) {
-        const ResourceEvent *ev = rm_log_event(rm, i);
-        json_object_begin(w, NULL);
-        json_string(w, "kind", ev->kind);
-        json_string(w, "desc", ev->desc);
-        hash_hex(ev->key, hex);
-        json_string(w, "key", hex);
-        json_string(w, "action", ev->built ? "built" : "reused");
-        json_number(w, "build_s", ev->build_s);
-        json_int(w, "bytes", (long long)ev->bytes);
-        json_object_end(w);
+        write_event(w, rm_log_event(rm, i));
+        any_built = any_built || rm_log_event(rm, i)->built;
     }
     json_array_end(w);
+    if (r->render) {
+        json_array_begin(w, "technique_resources");
+        for (int i = 0; i < r->render->num_tech_resources; i++) write_event(w, &r->render->tech_resources[i]);
+        json_array_end(w);
+    }
+    json_string(w, "resource_cache", any_built ? "cold" : "warm");
 }
 
 bool report_write_record(const RunReport *r, const char *path, Error *err)
 {
     AtomicFile af;
     if (!atomic_open(&af, path, err)) return false;
+    report_write_record_fp(r, af.fp);
+    return atomic_commit(&af, err);
+}
+
+void report_write_record_fp(const RunReport *r, FILE *fp)
+{
     JsonWriter w;
-    json_init(&w, af.fp);
+    json_init(&w, fp);
     json_object_begin(&w, NULL);
     json_string(&w, "shadowlab_record", "1");
     json_string(&w, "command", r->command);
@@ -194,7 +218,6 @@ bool report_write_record(const RunReport *r, const char *path, Error *err)
     write_machine(&w, r->threads);
     json_object_end(&w);
     json_finish(&w);
-    return atomic_commit(&af, err);
 }
 
 /* ---- the table for people ---------------------------------------------- */

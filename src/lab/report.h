@@ -36,6 +36,8 @@ bool report_write_all(RunReport *r, const char *dir, bool png, Error *err);
 bool report_write_exr(const RunReport *r, const char *path, Error *err);
 bool report_write_previews(const RunReport *r, const char *dir, Error *err);
 bool report_write_record(const RunReport *r, const char *path, Error *err);
+/* The same record onto an open stream (the Lua lab reads it from memory). */
+void report_write_record_fp(const RunReport *r, FILE *fp);
 void report_print(const RunReport *r, FILE *fp);
 
 #endif

@@ -1,24 +1,43 @@
-/* resources.c -- keyed resource cache with a per-run log (see resources.h).
- * A linear table: runs hold tens of resources, not thousands. */
+/* resources.c -- keyed resource cache with a per-run log and scopes (see
+ * resources.h). A linear table: runs hold tens of resources, not thousands.
+ * Each entry remembers the entries acquired while it was built, so a scope
+ * can name a reused resource's dependencies, and its own build time net of
+ * those nested builds. */
 #include "resources/resources.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/timer.h"
 
+#define RM_MAX_DEPTH 16
+
+typedef struct IntList { int *v; int n, cap; } IntList;
+
 typedef struct Entry {
     const ResourceKind *kind;
     uint64_t key;
     void *res;
-    double build_s;
+    double build_s;  /* wall time of its build, nested builds included */
+    double own_s;    /* build_s less the builds nested inside it */
     size_t bytes;
+    char desc[160];
+    IntList deps;    /* entries acquired while it was built */
 } Entry;
+
+/* A build in progress: what it acquires and how long its nested builds took. */
+typedef struct BuildFrame { IntList deps; double nested_s; } BuildFrame;
+
+/* A growable list of events, deduplicated by (kind, key). */
+typedef struct EventList { ResourceEvent *ev; int n, cap; } EventList;
 
 struct ResourceManager {
     Entry *entries;
     int count, cap;
-    ResourceEvent *log;
-    int log_count, log_cap;
+    EventList log;
+    BuildFrame frames[RM_MAX_DEPTH];
+    int depth;
+    bool scoping;
+    EventList scope;
 };
 
 ResourceManager *rm_create(void) { return calloc(1, sizeof(ResourceManager)); }
@@ -26,78 +45,140 @@ ResourceManager *rm_create(void) { return calloc(1, sizeof(ResourceManager)); }
 void rm_destroy(ResourceManager *rm)
 {
     if (!rm) return;
-    for (int i = rm->count - 1; i >= 0; i--) rm->entries[i].kind->destroy(rm->entries[i].res);
+    for (int i = rm->count - 1; i >= 0; i--) {
+        rm->entries[i].kind->destroy(rm->entries[i].res);
+        free(rm->entries[i].deps.v);
+    }
+    for (int d = 0; d < RM_MAX_DEPTH; d++) free(rm->frames[d].deps.v);
     free(rm->entries);
-    free(rm->log);
+    free(rm->log.ev);
+    free(rm->scope.ev);
     free(rm);
 }
 
-/* One line per resource per run: later requests in the same run add nothing. */
-static void log_event(ResourceManager *rm, const Entry *e, const char *desc, bool built)
+/* Bookkeeping lists: a failed allocation drops the item, never the run. */
+static void int_list_add_unique(IntList *l, int v)
 {
-    for (int i = 0; i < rm->log_count; i++)
-        if (rm->log[i].key == e->key && strcmp(rm->log[i].kind, e->kind->name) == 0) return;
-    if (rm->log_count == rm->log_cap) {
-        int cap = rm->log_cap ? 2 * rm->log_cap : 16;
-        ResourceEvent *nl = realloc(rm->log, sizeof *nl * (size_t)cap);
-        if (!nl) return; /* the log is bookkeeping: a full log drops events, never the run */
-        rm->log = nl;
-        rm->log_cap = cap;
+    for (int i = 0; i < l->n; i++)
+        if (l->v[i] == v) return;
+    if (l->n == l->cap) {
+        int cap = l->cap ? 2 * l->cap : 8;
+        int *nv = realloc(l->v, sizeof *nv * (size_t)cap);
+        if (!nv) return;
+        l->v = nv;
+        l->cap = cap;
     }
-    ResourceEvent *ev = &rm->log[rm->log_count++];
+    l->v[l->n++] = v;
+}
+
+/* One event per resource per list: later requests add nothing. */
+static bool event_add(EventList *l, const Entry *e, const char *desc, bool built)
+{
+    for (int i = 0; i < l->n; i++)
+        if (l->ev[i].key == e->key && strcmp(l->ev[i].kind, e->kind->name) == 0) return false;
+    if (l->n == l->cap) {
+        int cap = l->cap ? 2 * l->cap : 16;
+        ResourceEvent *nl = realloc(l->ev, sizeof *nl * (size_t)cap);
+        if (!nl) return false;
+        l->ev = nl;
+        l->cap = cap;
+    }
+    ResourceEvent *ev = &l->ev[l->n++];
     ev->kind = e->kind->name;
     snprintf(ev->desc, sizeof ev->desc, "%s", desc);
     ev->key = e->key;
     ev->built = built;
     ev->build_s = e->build_s;
+    ev->own_s = e->own_s;
     ev->bytes = e->bytes;
+    return true;
 }
 
-static Entry *find(ResourceManager *rm, const ResourceKind *kind, uint64_t key)
+/* Record entry `i` in the open scope with, when newly recorded, the entries
+ * it was built from (reused here even if this run never asked for them). */
+static void scope_add(ResourceManager *rm, int i, bool built)
+{
+    const Entry *e = &rm->entries[i];
+    if (!event_add(&rm->scope, e, e->desc, built)) return;
+    for (int d = 0; d < e->deps.n; d++) scope_add(rm, e->deps.v[d], false);
+}
+
+static int find(const ResourceManager *rm, const ResourceKind *kind, uint64_t key)
 {
     for (int i = 0; i < rm->count; i++)
-        if (rm->entries[i].kind == kind && rm->entries[i].key == key) return &rm->entries[i];
-    return NULL;
+        if (rm->entries[i].kind == kind && rm->entries[i].key == key) return i;
+    return -1;
+}
+
+/* Build, time and store a new entry; its index, or -1 with err set. */
+static int build_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc,
+                       ResourceBuildFn build, const void *args, Error *err)
+{
+    if (rm->depth == RM_MAX_DEPTH) {
+        error_set(err, "resources nested more than %d deep (building %s)", RM_MAX_DEPTH, kind->name);
+        return -1;
+    }
+    BuildFrame *f = &rm->frames[rm->depth++];
+    f->deps.n = 0;
+    f->nested_s = 0;
+    double t0 = timer_now_s();
+    void *res = build(args, err);
+    double dt = timer_now_s() - t0;
+    rm->depth--;
+    if (!res) return -1;
+    if (rm->count == rm->cap) {
+        int cap = rm->cap ? 2 * rm->cap : 16;
+        Entry *ne = realloc(rm->entries, sizeof *ne * (size_t)cap);
+        if (!ne) {
+            kind->destroy(res);
+            error_set(err, "out of memory in the resource manager");
+            return -1;
+        }
+        rm->entries = ne;
+        rm->cap = cap;
+    }
+    Entry *e = &rm->entries[rm->count];
+    *e = (Entry){kind, key, res, dt, dt > f->nested_s ? dt - f->nested_s : 0.0, kind->bytes(res), "", {NULL, 0, 0}};
+    snprintf(e->desc, sizeof e->desc, "%s", desc);
+    for (int i = 0; i < f->deps.n; i++) int_list_add_unique(&e->deps, f->deps.v[i]);
+    if (rm->depth > 0) rm->frames[rm->depth - 1].nested_s += dt;
+    return rm->count++;
 }
 
 void *rm_acquire(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc,
                  ResourceBuildFn build, const void *args, Error *err)
 {
-    Entry *e = find(rm, kind, key);
-    if (e) {
-        log_event(rm, e, desc, false);
-        return e->res;
-    }
-    if (rm->count == rm->cap) {
-        int cap = rm->cap ? 2 * rm->cap : 16;
-        Entry *ne = realloc(rm->entries, sizeof *ne * (size_t)cap);
-        if (!ne) { error_set(err, "out of memory in the resource manager"); return NULL; }
-        rm->entries = ne;
-        rm->cap = cap;
-    }
-    double t0 = timer_now_s();
-    void *res = build(args, err);
-    if (!res) return NULL;
-    e = &rm->entries[rm->count++];
-    *e = (Entry){kind, key, res, timer_now_s() - t0, kind->bytes(res)};
-    log_event(rm, e, desc, true);
-    return res;
+    int i = find(rm, kind, key);
+    bool built = i < 0;
+    if (built && (i = build_entry(rm, kind, key, desc, build, args, err)) < 0) return NULL;
+    event_add(&rm->log, &rm->entries[i], desc, built);
+    if (rm->depth > 0) int_list_add_unique(&rm->frames[rm->depth - 1].deps, i);
+    if (rm->scoping) scope_add(rm, i, built);
+    return rm->entries[i].res;
 }
 
-int rm_log_count(const ResourceManager *rm) { return rm->log_count; }
-const ResourceEvent *rm_log_event(const ResourceManager *rm, int i) { return &rm->log[i]; }
-void rm_log_reset(ResourceManager *rm) { rm->log_count = 0; }
+int rm_log_count(const ResourceManager *rm) { return rm->log.n; }
+const ResourceEvent *rm_log_event(const ResourceManager *rm, int i) { return &rm->log.ev[i]; }
+void rm_log_reset(ResourceManager *rm) { rm->log.n = 0; }
 
 void rm_log_note(ResourceManager *rm, const char *kind, uint64_t key, const char *note)
 {
-    for (int i = 0; i < rm->log_count; i++) {
-        ResourceEvent *ev = &rm->log[i];
+    for (int i = 0; i < rm->log.n; i++) {
+        ResourceEvent *ev = &rm->log.ev[i];
         if (ev->key != key || strcmp(ev->kind, kind) != 0) continue;
         size_t n = strlen(ev->desc);
         snprintf(ev->desc + n, sizeof ev->desc - n, " (%s)", note);
     }
 }
 
+void rm_scope_begin(ResourceManager *rm)
+{
+    rm->scoping = true;
+    rm->scope.n = 0;
+}
+void rm_scope_end(ResourceManager *rm) { rm->scoping = false; }
+int rm_scope_count(const ResourceManager *rm) { return rm->scope.n; }
+const ResourceEvent *rm_scope_event(const ResourceManager *rm, int i) { return &rm->scope.ev[i]; }
 size_t rm_bytes(const ResourceManager *rm)
 {
     size_t b = 0;

@@ -30,6 +30,7 @@ typedef struct ResourceEvent {
     bool built;       /* false: reused */
     double build_s;   /* time of the build that made it (also shown on reuse) */
     size_t bytes;
+    double own_s;     /* build_s less the builds of resources acquired inside it */
 } ResourceEvent;
 
 typedef struct ResourceManager ResourceManager;
@@ -49,6 +50,17 @@ void rm_log_reset(ResourceManager *rm);
 /* Append a note to the logged description of (kind name, key), e.g. where a
  * resource was loaded from. */
 void rm_log_note(ResourceManager *rm, const char *kind, uint64_t key, const char *note);
+
+/* Scopes: what one stage (a technique's prepare) depends on. Between
+ * rm_scope_begin and rm_scope_end every acquisition is recorded once, built or
+ * reused, together with the resources it was built from (also when it is
+ * reused and they are not asked for again), so the sum of their own_s is the
+ * cost of building the stage's resources from nothing, whatever an earlier
+ * stage or run already built. `built` is true for builds inside the scope. */
+void rm_scope_begin(ResourceManager *rm);
+void rm_scope_end(ResourceManager *rm);
+int rm_scope_count(const ResourceManager *rm);
+const ResourceEvent *rm_scope_event(const ResourceManager *rm, int i);
 
 /* Totals over everything the manager holds. */
 size_t rm_bytes(const ResourceManager *rm);
