@@ -61,4 +61,10 @@ typedef struct Technique {
     void (*release)(void *state);
 } Technique;
 
+/* Store one visibility for sample s in an evaluate's output (all channels). */
+static inline void tech_store(const TechContext *ctx, float *out, int begin, int s, float v)
+{
+    for (int c = 0; c < ctx->channels; c++) out[(size_t)(s - begin) * (size_t)ctx->channels + c] = v;
+}
+
 #endif

@@ -1,0 +1,96 @@
+/* raster.h -- the depth-only triangle rasterizer for light-space maps
+ * (course §2.1: "render depth from the light"). Triangles are transformed
+ * once per vertex, clipped in homogeneous space against the full frustum
+ * (0 <= z <= w, |x|, |y| <= w), snapped to 8 sub-texel bits and filled with
+ * exact integer edge functions and the top-left rule, so a closed mesh
+ * covers each texel exactly once. Work is binned into 64x64-texel tiles and
+ * the tiles are filled in parallel (OpenMP).
+ *
+ * Map space: texel (i, j) covers u in [i/W, (i+1)/W], v in [j/H, (j+1)/H]
+ * with u = (x_ndc + 1)/2, v = (y_ndc + 1)/2; row j = 0 is v = 0 (y_ndc = -1,
+ * the texture convention), and depth is sampled at texel centres. */
+#ifndef SL_RASTER_H
+#define SL_RASTER_H
+#include <stdint.h>
+#include "core/error.h"
+#include "core/mat4.h"
+
+#define RASTER_MAX_SIZE 16384 /* texels per side */
+#define RASTER_SUBPIXEL_BITS 8
+
+/* One indexed triangle mesh in world space (CCW = front, right-hand rule). */
+typedef struct RasterMesh {
+    const vec3 *positions;
+    const uint32_t *indices; /* 3 per triangle */
+    int num_vertices, num_triangles;
+} RasterMesh;
+
+typedef enum RasterCull { RASTER_CULL_NONE, RASTER_CULL_BACK, RASTER_CULL_FRONT } RasterCull;
+/* Which surface a texel keeps: the nearest (shadow maps) or the farthest
+ * (back-face and farthest-layer maps). */
+typedef enum RasterTest { RASTER_NEAREST, RASTER_FARTHEST } RasterTest;
+/* What a texel stores: linear depth (an affine function of the world
+ * position, e.g. distance along the light's axis in world units) or the
+ * post-projective z_ndc in [0, 1]. */
+typedef enum RasterDepth { RASTER_DEPTH_LINEAR, RASTER_DEPTH_NDC } RasterDepth;
+/* How vertices reach the map: a projective matrix (exact for triangles), or
+ * the dual-paraboloid mapping of Brabec et al. (course §2.1.1): per vertex
+ * only, so edges are straight in the map while they should be curved. */
+typedef enum RasterMapping { RASTER_PROJECTIVE, RASTER_PARABOLOID } RasterMapping;
+
+typedef struct RasterView {
+    RasterMapping mapping;
+    /* RASTER_PROJECTIVE: world -> clip. RASTER_PARABOLOID: world -> light view
+     * space (right-handed, the hemisphere looks down -z). */
+    mat4 clip_from_world;
+    /* Linear depth of a world point, d = row . (x, y, z, 1), for
+     * RASTER_PROJECTIVE (paraboloid maps store the distance to the centre). */
+    double depth_row[4];
+    double depth_near, depth_far; /* linear depth range (quantisation, paraboloid z) */
+} RasterView;
+
+typedef struct RasterOptions {
+    RasterCull cull;
+    RasterTest test;
+    RasterDepth depth;
+    int depth_bits;       /* 0: float32 as computed; 16 or 24: quantised over the range */
+    bool conservative;    /* cover every texel the triangle touches (depth clamped to its range) */
+    bool triangle_ids;    /* also store the winning triangle's index per texel */
+    /* Depth peeling: when non-NULL (same size as the map), fragments at or in
+     * front of peel[texel] are discarded, so the map keeps the next layer. */
+    const float *peel;
+} RasterOptions;
+
+/* The output: depth per texel (+INFINITY where nothing was drawn with the
+ * nearest test, -INFINITY with the farthest), and optionally triangle ids
+ * (-1 where empty; ids count triangles across the meshes in order). */
+typedef struct DepthBuffer {
+    int width, height;
+    float *depth;
+    int32_t *triangle;
+} DepthBuffer;
+
+/* What a render did, for records and benchmarks. */
+typedef struct RasterStats {
+    long triangles_in, triangles_culled, triangles_clipped, triangles_drawn;
+    long texels_written;
+} RasterStats;
+
+bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids, Error *err);
+void depth_buffer_free(DepthBuffer *db);
+
+/* Render the meshes into db (already sized; cleared here). */
+bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *view, const RasterOptions *opt,
+                  DepthBuffer *db, RasterStats *stats, Error *err);
+
+/* Paraboloid mapping of a light-view-space point on the front (-z) hemisphere:
+ * (x, y) / (1 + |z| / r) / r with r = |p|, the map's (x_ndc, y_ndc). */
+static inline void paraboloid_ndc(dvec3 p_view, double *x_ndc, double *y_ndc, double *r)
+{
+    *r = d3_len(p_view);
+    double k = *r > 0.0 ? 1.0 / (*r - p_view.z) : 0.0; /* -z >= 0 on the front hemisphere */
+    *x_ndc = p_view.x * k;
+    *y_ndc = p_view.y * k;
+}
+
+#endif

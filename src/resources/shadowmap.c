@@ -1,0 +1,188 @@
+/* shadowmap.c -- building and keying light-space depth maps (shadowmap.h). */
+#include "resources/shadowmap.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "core/hash.h"
+#include "resources/standard.h"
+
+ShadowMapSpec shadowmap_spec_default(void)
+{
+    return (ShadowMapSpec){.res = 1024, .projection = MAP_PROJ_AUTO, .fit = MAP_FIT_SCENE,
+                           .depth = RASTER_DEPTH_LINEAR, .layer = MAP_LAYER_FIRST, .cull = RASTER_CULL_NONE};
+}
+
+/* Faces the map may need: AUTO may turn a point or sphere light into a cube. */
+static int max_faces(const Light *light, MapProjection p)
+{
+    if (p == MAP_PROJ_CUBE) return 6;
+    if (p == MAP_PROJ_PARABOLOID) return 2;
+    if (p == MAP_PROJ_AUTO && (light->kind == LIGHT_POINT || light->kind == LIGHT_SPHERE)) return 6;
+    return 1;
+}
+
+size_t shadowmap_bytes_for(const Light *light, const ShadowMapSpec *spec)
+{
+    size_t texels = (size_t)max_faces(light, spec->projection) * (size_t)spec->res * (size_t)spec->res;
+    return texels * (sizeof(float) + (spec->triangle_ids ? sizeof(int32_t) : 0));
+}
+
+static void map_destroy(void *r)
+{
+    ShadowMap *m = r;
+    free(m->depth);
+    free(m->triangle);
+    free(m);
+}
+
+static size_t map_bytes(const void *r)
+{
+    const ShadowMap *m = r;
+    size_t texels = (size_t)m->num_faces * (size_t)m->res * (size_t)m->res;
+    return sizeof *m + texels * (sizeof(float) + (m->triangle ? sizeof(int32_t) : 0));
+}
+
+static const ResourceKind kind_shadow_map = {"shadow_map", map_bytes, map_destroy};
+
+typedef struct MapArgs {
+    ResourceManager *rm;
+    const Scene *scene;
+    int light_index;
+    ShadowMapSpec spec;
+} MapArgs;
+
+static int caster_meshes(const Scene *sc, RasterMesh *out)
+{
+    int n = 0;
+    for (int i = 0; i < sc->num_objects; i++) {
+        const Object *o = &sc->objects[i];
+        if (!o->caster) continue;
+        out[n++] = (RasterMesh){o->mesh.positions, o->mesh.indices, o->mesh.num_vertices, o->mesh.num_triangles};
+    }
+    return n;
+}
+
+static RasterOptions raster_options(const ShadowMapSpec *spec, const float *peel)
+{
+    RasterOptions o = {.cull = spec->cull, .test = RASTER_NEAREST, .depth = spec->depth,
+                       .depth_bits = spec->depth_bits, .conservative = spec->conservative,
+                       .triangle_ids = spec->triangle_ids, .peel = peel};
+    if (spec->layer == MAP_LAYER_BACKFACES) o.cull = RASTER_CULL_FRONT;
+    if (spec->layer == MAP_LAYER_PEELED) o.cull = RASTER_CULL_NONE;
+    return o;
+}
+
+/* The first layer a peeled map peels behind: unquantised, no ids, same view. */
+static const ShadowMap *peel_source(const MapArgs *a, Error *err)
+{
+    ShadowMapSpec first = a->spec;
+    first.layer = MAP_LAYER_FIRST;
+    first.cull = RASTER_CULL_NONE;
+    first.depth_bits = 0;
+    first.triangle_ids = false;
+    return res_shadow_map(a->rm, a->scene, a->light_index, &first, err);
+}
+
+static bool render_faces(ShadowMap *m, const MapArgs *a, const ShadowMap *under, Error *err)
+{
+    RasterMesh *meshes = malloc(sizeof *meshes * (size_t)(a->scene->num_objects > 0 ? a->scene->num_objects : 1));
+    if (!meshes) return error_set(err, "out of memory");
+    int nm = caster_meshes(a->scene, meshes);
+    size_t face_texels = (size_t)m->res * (size_t)m->res;
+    bool ok = true;
+    for (int f = 0; ok && f < m->num_faces; f++) {
+        DepthBuffer db = {m->res, m->res, m->depth + f * face_texels, m->triangle ? m->triangle + f * face_texels : NULL};
+        RasterOptions opt = raster_options(&a->spec, under ? under->depth + f * face_texels : NULL);
+        RasterStats st;
+        ok = raster_depth(meshes, nm, &m->view.face[f].raster, &opt, &db, &st, err);
+        m->stats.triangles_in += st.triangles_in;
+        m->stats.triangles_culled += st.triangles_culled;
+        m->stats.triangles_clipped += st.triangles_clipped;
+        m->stats.triangles_drawn += st.triangles_drawn;
+        m->stats.texels_written += st.texels_written;
+    }
+    free(meshes);
+    return ok;
+}
+
+static void *build_map(const void *args, Error *err)
+{
+    const MapArgs *a = args;
+    const Scene *sc = a->scene;
+    const ViewSamples *vs = NULL;
+    const uint8_t *cls = NULL;
+    if (a->spec.fit == MAP_FIT_VIEW) {
+        vs = res_view_samples(a->rm, sc, err);
+        cls = vs ? res_classes(a->rm, sc, a->light_index, err) : NULL;
+        if (!cls) return NULL;
+    }
+    const ShadowMap *under = a->spec.layer == MAP_LAYER_PEELED ? peel_source(a, err) : NULL;
+    if (a->spec.layer == MAP_LAYER_PEELED && !under) return NULL;
+    ShadowMap *m = calloc(1, sizeof *m);
+    if (!m) { error_set(err, "out of memory"); return NULL; }
+    m->spec = a->spec;
+    if (!lightview_fit(sc, &sc->lights[a->light_index], a->spec.projection, a->spec.fit, a->spec.res, vs, cls,
+                       &m->view, err)) {
+        free(m);
+        return NULL;
+    }
+    m->res = a->spec.res;
+    m->num_faces = m->view.num_faces;
+    size_t texels = (size_t)m->num_faces * (size_t)m->res * (size_t)m->res;
+    m->depth = malloc(texels * sizeof *m->depth);
+    if (a->spec.triangle_ids) m->triangle = malloc(texels * sizeof *m->triangle);
+    if (!m->depth || (a->spec.triangle_ids && !m->triangle)) {
+        error_set(err, "out of memory for a %d-face %d^2 shadow map", m->num_faces, m->res);
+        map_destroy(m);
+        return NULL;
+    }
+    if (!render_faces(m, a, under, err)) {
+        map_destroy(m);
+        return NULL;
+    }
+    return m;
+}
+
+static uint64_t map_key(const Scene *sc, int light_index, const ShadowMapSpec *s)
+{
+    Hasher h;
+    hash_init(&h);
+    hash_u64(&h, sc->hash_casters);                 /* what is drawn */
+    hash_u64(&h, sc->hash_geometry);                /* the bounds it is fitted to */
+    hash_u64(&h, sc->hash_lights[light_index]);
+    if (s->fit == MAP_FIT_VIEW) hash_u64(&h, sc->hash_camera);
+    const int64_t fields[] = {s->res, s->projection, s->fit, s->depth, s->depth_bits, s->layer,
+                              s->cull, s->triangle_ids, s->conservative};
+    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) hash_u64(&h, (uint64_t)fields[i]);
+    return hash_final(&h);
+}
+
+static const char *layer_name(MapLayer l)
+{
+    static const char *const names[] = {"first layer", "back faces", "peeled second layer"};
+    return names[l];
+}
+
+const ShadowMap *res_shadow_map(ResourceManager *rm, const Scene *scene, int light_index, const ShadowMapSpec *spec,
+                                Error *err)
+{
+    const Light *light = &scene->lights[light_index];
+    if (spec->res < 1 || spec->res > RASTER_MAX_SIZE) {
+        error_set(err, "map_size %d outside [1, %d]", spec->res, RASTER_MAX_SIZE);
+        return NULL;
+    }
+    size_t bytes = shadowmap_bytes_for(light, spec);
+    if (bytes > SHADOWMAP_MAX_BYTES) {
+        error_set(err, "map_size %d: a %d-face map needs %.2f GiB, above the %.0f GiB cap on shadow maps", spec->res,
+                  max_faces(light, spec->projection), (double)bytes / (1 << 30), (double)SHADOWMAP_MAX_BYTES / (1 << 30));
+        return NULL;
+    }
+    MapArgs a = {rm, scene, light_index, *spec};
+    char desc[160];
+    snprintf(desc, sizeof desc, "light %d, %d^2 %s, fit %s, %s %s, %s%s", light_index + 1, spec->res,
+             map_projection_name(spec->projection), map_fit_name(spec->fit),
+             spec->depth == RASTER_DEPTH_LINEAR ? "linear" : "ndc",
+             spec->depth_bits ? (spec->depth_bits == 16 ? "16-bit" : "24-bit") : "f32", layer_name(spec->layer),
+             spec->cull == RASTER_CULL_BACK ? ", back faces culled" : "");
+    return rm_acquire(rm, &kind_shadow_map, map_key(scene, light_index, spec), desc, build_map, &a, err);
+}

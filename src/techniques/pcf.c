@@ -1,0 +1,168 @@
+/* pcf.c -- `pcf`: percentage-closer filtering (Reeves 1987; course §4.1.2,
+ * Eq. 4.1): the depth test is done first, then filtered,
+ * pcf(p) = sum_q w(p - q) S(p_z, z_q). Kernels: a K x K box; the same box
+ * over hardware-style 2x2 bilinear taps (a (K+1)^2 footprint with tent
+ * weights at its rim); a Poisson disk of diameter K texels, rotated per
+ * pixel; and adaptive PCF (Uralsky 2005, course §4.2): the first taps of
+ * the disk, and all of them only where those disagree (the penumbra). */
+#include <stdlib.h>
+#include "core/hash.h"
+#include "techniques/smap.h"
+
+enum { KERNEL_BOX, KERNEL_BILINEAR, KERNEL_POISSON, KERNEL_ADAPTIVE };
+static const char *const kernel_names[] = {"box", "bilinear", "poisson", "adaptive", NULL};
+
+enum { P_K = SMAP_NUM_PARAMS, P_KERNEL, P_SAMPLES, P_INITIAL, P_ROTATE };
+
+#define PCF_MAX_K 63
+#define PCF_MAX_SAMPLES 256
+
+static const ParamDesc pcf_params[] = {
+    SMAP_MAP_PARAMS,
+    SMAP_BIAS_PARAMS,
+    {"K", PARAM_INT, 5, 1, PCF_MAX_K, "texels", "kernel width: the filter covers K x K texels (the disk's diameter)", NULL},
+    {"kernel", PARAM_ENUM, KERNEL_BOX, 0, 3, "",
+     "box (K^2 taps), bilinear (K^2 hardware 2x2 taps), poisson (disk, rotated per pixel) or adaptive", kernel_names},
+    {"samples", PARAM_INT, 16, 1, PCF_MAX_SAMPLES, "taps", "poisson and adaptive: taps in the disk", NULL},
+    {"initial", PARAM_INT, 4, 1, PCF_MAX_SAMPLES, "taps",
+     "adaptive: taps tried first; the rest only where they disagree", NULL},
+    {"rotate", PARAM_BOOL, 1, 0, 1, "", "poisson and adaptive: rotate the disk per pixel (banding becomes noise)", NULL},
+};
+
+static const char *const pcf_resources[] = {"shadow_map", "view_samples", NULL};
+
+typedef struct PcfState {
+    const ShadowMap *map;
+    SmapBias bias;
+    int K, kernel, samples, initial;
+    bool rotate;
+    float disk[PCF_MAX_SAMPLES][2]; /* unit disk, progressive: every prefix is well spread */
+} PcfState;
+
+/* Mitchell's best-candidate points in the unit disk: each new point is the
+ * farthest of 32 i candidates from those placed, so prefixes stay uniform. */
+static void poisson_disk(float (*pts)[2], int n)
+{
+    uint32_t state = 0x9e3779b9u;
+    for (int i = 0; i < n; i++) {
+        double best = -1.0;
+        for (int c = 0; c < 32 * (i + 1); c++) {
+            state = hash_u32(state + (uint32_t)c);
+            double a = 2.0 * M_PI * (state >> 8) / 16777216.0;
+            state = hash_u32(state);
+            double r = sqrt((state >> 8) / 16777216.0), x = r * cos(a), y = r * sin(a), d = INFINITY;
+            for (int k = 0; k < i; k++) d = fmin(d, (x - pts[k][0]) * (x - pts[k][0]) + (y - pts[k][1]) * (y - pts[k][1]));
+            if (d > best) {
+                best = d;
+                pts[i][0] = (float)x;
+                pts[i][1] = (float)y;
+            }
+        }
+    }
+}
+
+static bool pcf_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    const double *p = ctx->params;
+    PcfState *st = malloc(sizeof *st);
+    if (!st) return error_set(err, "out of memory");
+    ShadowMapSpec spec = smap_spec(p);
+    st->map = res_shadow_map(ctx->rm, ctx->scene, ctx->light_index, &spec, err);
+    if (!st->map) {
+        free(st);
+        return false;
+    }
+    st->bias = smap_bias(p, ctx->scene);
+    st->K = (int)p[P_K];
+    st->kernel = (int)p[P_KERNEL];
+    st->samples = (int)p[P_SAMPLES];
+    st->initial = (int)p[P_INITIAL] < st->samples ? (int)p[P_INITIAL] : st->samples;
+    st->rotate = p[P_ROTATE] != 0.0;
+    if (st->kernel >= KERNEL_POISSON) poisson_disk(st->disk, st->samples);
+    *state = st;
+    return true;
+}
+
+/* Box: K x K texel centres around (s, t); the first is at floor(s - K/2 + 1/2). */
+static float filter_box(const PcfState *st, const SmapReceiver *r)
+{
+    int i0 = (int)floor(r->mc.s - 0.5 * st->K + 0.5), j0 = (int)floor(r->mc.t - 0.5 * st->K + 0.5);
+    float lit = 0.0f;
+    for (int j = j0; j < j0 + st->K; j++)
+        for (int i = i0; i < i0 + st->K; i++) lit += smap_lit(st->map, r, i, j);
+    return lit / (float)(st->K * st->K);
+}
+
+/* K bilinear taps per axis at s - (K-1)/2 ... s + (K-1)/2 add up to weights
+ * 1 - f, 1, ..., 1, f over K + 1 texels (f: the taps' fractional position). */
+static float filter_bilinear(const PcfState *st, const SmapReceiver *r)
+{
+    double fs = r->mc.s - 0.5 * (st->K - 1) - 0.5, ft = r->mc.t - 0.5 * (st->K - 1) - 0.5;
+    int i0 = (int)floor(fs), j0 = (int)floor(ft);
+    double ax = fs - i0, ay = ft - j0, lit = 0.0;
+    for (int j = 0; j <= st->K; j++) {
+        double wy = j == 0 ? 1.0 - ay : j == st->K ? ay : 1.0;
+        for (int i = 0; i <= st->K; i++) {
+            double wx = i == 0 ? 1.0 - ax : i == st->K ? ax : 1.0;
+            lit += wx * wy * smap_lit(st->map, r, i0 + i, j0 + j);
+        }
+    }
+    return (float)(lit / ((double)st->K * st->K));
+}
+
+/* Taps [first, last) of the disk of diameter K texels, rotated by angle. */
+static int disk_lit(const PcfState *st, const SmapReceiver *r, int first, int last, double cs, double sn)
+{
+    double radius = 0.5 * st->K;
+    int lit = 0;
+    for (int k = first; k < last; k++) {
+        double x = st->disk[k][0], y = st->disk[k][1];
+        double s = r->mc.s + radius * (cs * x - sn * y), t = r->mc.t + radius * (sn * x + cs * y);
+        lit += smap_lit(st->map, r, (int)floor(s), (int)floor(t)) > 0.0f;
+    }
+    return lit;
+}
+
+static float filter_disk(const PcfState *st, const SmapReceiver *r, uint32_t sample)
+{
+    double a = st->rotate ? 2.0 * M_PI * (hash_u32(sample) >> 8) / 16777216.0 : 0.0;
+    double cs = cos(a), sn = sin(a);
+    int n0 = st->kernel == KERNEL_ADAPTIVE ? st->initial : st->samples;
+    int lit = disk_lit(st, r, 0, n0, cs, sn);
+    if (n0 == st->samples || lit == 0 || lit == n0) return (float)lit / (float)n0;
+    lit += disk_lit(st, r, n0, st->samples, cs, sn);
+    return (float)lit / (float)st->samples;
+}
+
+static void pcf_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
+{
+    const PcfState *st = state;
+    for (int s = begin; s < end; s++) {
+        if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        SmapReceiver r;
+        float v = 1.0f;
+        if (smap_receiver(st->map, &st->bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r)) {
+            switch (st->kernel) {
+            case KERNEL_BOX: v = filter_box(st, &r); break;
+            case KERNEL_BILINEAR: v = filter_bilinear(st, &r); break;
+            default: v = filter_disk(st, &r, (uint32_t)s); break;
+            }
+        }
+        tech_store(ctx, out, begin, s, v);
+    }
+}
+
+const Technique tech_pcf = {
+    .name = "pcf",
+    .family = "filtered",
+    .source = "course §4.1.2 (Eq. 4.1, Reeves 1987), §4.2 (adaptive PCF, Uralsky 2005)",
+    .summary = "percentage-closer filtering over K x K texels: box, bilinear, rotated Poisson disk or adaptive",
+    .params = pcf_params,
+    .num_params = (int)(sizeof pcf_params / sizeof pcf_params[0]),
+    .resources = pcf_resources,
+    .rgb = false,
+    .lights = LIGHTS_ALL,
+    .prepare = pcf_prepare,
+    .evaluate = pcf_evaluate,
+    .release = free,
+};

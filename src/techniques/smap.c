@@ -1,0 +1,113 @@
+/* smap.c -- shared shadow-map parameters, biases and lookups (smap.h). */
+#include "techniques/smap.h"
+#include <float.h>
+
+const char *const smap_projection_names[] = {MAP_PROJ_NAMES, NULL};
+const char *const smap_fit_names[] = {MAP_FIT_NAMES, NULL};
+const char *const smap_depth_names[] = {"linear", "ndc", NULL};
+const char *const smap_bits_names[] = {"f32", "u24", "u16", NULL};
+
+ShadowMapSpec smap_spec(const double *p)
+{
+    static const int bits[] = {0, 24, 16};
+    ShadowMapSpec s = shadowmap_spec_default();
+    s.res = (int)p[SMAP_P_MAP_SIZE];
+    s.projection = (MapProjection)(int)p[SMAP_P_PROJECTION];
+    s.fit = (MapFit)(int)p[SMAP_P_FIT];
+    s.depth = (int)p[SMAP_P_DEPTH] == 1 ? RASTER_DEPTH_NDC : RASTER_DEPTH_LINEAR;
+    s.depth_bits = bits[(int)p[SMAP_P_DEPTH_BITS]];
+    return s;
+}
+
+SmapBias smap_bias(const double *p, const Scene *scene)
+{
+    return (SmapBias){p[SMAP_P_BIAS], p[SMAP_P_BIAS_STEPS], p[SMAP_P_SLOPE_BIAS], p[SMAP_P_SLOPE_MAX],
+                      p[SMAP_P_NORMAL_OFFSET], p[SMAP_P_RECEIVER_PLANE] != 0.0, scene_extent(scene)};
+}
+
+/* World size of one step of the stored depth at the receiver (the r of
+ * glPolygonOffset): a quantisation level, or a float32 ulp. */
+static double depth_step_world(const ShadowMap *m, const MapCoord *mc, double ndc_per_world)
+{
+    const RasterView *rv = &m->view.face[mc->face].raster;
+    int bits = m->spec.depth_bits;
+    if (m->spec.depth == RASTER_DEPTH_LINEAR)
+        return bits ? (rv->depth_far - rv->depth_near) / (double)((1u << bits) - 1u)
+                    : fabs(mc->depth_linear) * FLT_EPSILON;
+    double step_ndc = bits ? 1.0 / (double)((1u << bits) - 1u) : fmax(fabs(mc->z_ndc), FLT_MIN) * FLT_EPSILON;
+    return step_ndc / ndc_per_world;
+}
+
+static double stored_depth(const ShadowMap *m, const MapCoord *mc)
+{
+    return m->spec.depth == RASTER_DEPTH_NDC ? mc->z_ndc : mc->depth_linear;
+}
+
+/* The receiver's plane (point q, normal n) seen through texel coordinates
+ * (s, t) of the face, in the affine metric g (course §4.1.2 box). */
+static bool plane_metric(const ShadowMap *m, const SmapReceiver *r, dvec3 q, dvec3 n, double s, double t, double *g)
+{
+    dvec3 org, dir;
+    lightview_texel_ray(&m->view, r->mc.face, s, t, &org, &dir);
+    double dn = d3_dot(dir, n);
+    if (!(fabs(dn) > 1e-9)) return false; /* the ray runs along the plane: grazing light */
+    dvec3 x = d3_madd(org, dir, d3_dot(d3_sub(q, org), n) / dn);
+    MapCoord c = lightview_locate_on(&m->view, r->mc.face, x);
+    double v = stored_depth(m, &c);
+    if (r->reciprocal && !(v > 0.0)) return false;
+    *g = r->reciprocal ? 1.0 / v : v;
+    return isfinite(*g);
+}
+
+/* g0, gs, gt of the receiver's plane: exact for projective maps, where
+ * planes stay planes (1/depth is affine on screen under perspective). */
+static bool receiver_plane(const ShadowMap *m, SmapReceiver *r, dvec3 q, dvec3 n)
+{
+    const MapFace *f = &m->view.face[r->mc.face];
+    r->reciprocal = f->perspective && m->spec.depth == RASTER_DEPTH_LINEAR;
+    double g0, g1, g2, s = r->mc.s, t = r->mc.t;
+    if (!plane_metric(m, r, q, n, s, t, &g0) || !plane_metric(m, r, q, n, s + 1.0, t, &g1) ||
+        !plane_metric(m, r, q, n, s, t + 1.0, &g2))
+        return false;
+    r->g0 = g0;
+    r->gs = g1 - g0;
+    r->gt = g2 - g0;
+    return true;
+}
+
+/* glPolygonOffset's m: the stored depth's largest change across one texel
+ * on the receiver's plane, max(|dz/ds|, |dz/dt|). */
+static double depth_slope(const SmapReceiver *r)
+{
+    double k = r->reciprocal ? 1.0 / (r->g0 * r->g0) : 1.0; /* d = 1/g: |dd| = |dg| / g^2 */
+    return fmax(fabs(r->gs), fabs(r->gt)) * k;
+}
+
+bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_geom_world, SmapReceiver *r)
+{
+    const LightView *lv = &m->view;
+    dvec3 n = d3_from(n_geom_world);
+    dvec3 p = d3_madd(d3_from(p_world), n, rt_ray_offset(b->scene_extent, p_world));
+    r->mc = lightview_locate(lv, p);
+    r->texel_world = lightview_texel_world(lv, &r->mc);
+    if (b->normal_offset_texels > 0.0) {
+        p = d3_madd(p, n, b->normal_offset_texels * r->texel_world);
+        r->mc = lightview_locate(lv, p);
+        r->texel_world = lightview_texel_world(lv, &r->mc);
+    }
+    r->plane = false;
+    if (!r->mc.inside) return false;
+    double ndc_per_world = lightview_ndc_per_world(lv, &r->mc);
+    double to_stored = m->spec.depth == RASTER_DEPTH_NDC ? ndc_per_world : 1.0;
+    bool plane = (b->receiver_plane || b->slope > 0.0) && receiver_plane(m, r, p, n);
+    /* Slope-scaled bias (course §2.1.2: faces aligned with the light's rays
+     * need much more): factor x depth slope, clamped, since the slope
+     * diverges at grazing light (where the plane is lost, the clamp). */
+    double slope_max = b->slope_max_texels * r->texel_world * to_stored;
+    double slope = plane ? fmin(b->slope * depth_slope(r), slope_max) : b->slope > 0.0 ? slope_max : 0.0;
+    double constant = (b->constant_world + b->steps * depth_step_world(m, &r->mc, ndc_per_world)) * to_stored;
+    r->bias = constant + slope;
+    r->ref = stored_depth(m, &r->mc) - r->bias;
+    r->plane = plane && b->receiver_plane;
+    return true;
+}

@@ -1,0 +1,114 @@
+/* smap.h -- what every shadow-map technique shares: the map's parameters and
+ * the depth-bias remedies of course §2.1.2, declared once here and expanded
+ * into each technique's parameter table (so `list`, the CLI and Lua see the
+ * same names, ranges and docs everywhere), and the lookup of a view sample
+ * in the map: texel coordinates and the biased reference depth, per texel
+ * when the receiver-plane bias is on.
+ *
+ * A technique's table starts with SMAP_MAP_PARAMS then SMAP_BIAS_PARAMS;
+ * its own parameters follow at index SMAP_NUM_PARAMS. */
+#ifndef SL_SMAP_H
+#define SL_SMAP_H
+#include "resources/shadowmap.h"
+#include "techniques/technique.h"
+
+extern const char *const smap_projection_names[];
+extern const char *const smap_fit_names[];
+extern const char *const smap_depth_names[];
+extern const char *const smap_bits_names[];
+
+#define SMAP_MAP_PARAMS                                                                                            \
+    {"map_size", PARAM_INT, 1024, 1, RASTER_MAX_SIZE, "texels",                                                     \
+     "shadow-map resolution per side (per face for cube and paraboloid maps)", NULL},                              \
+    {"projection", PARAM_ENUM, 0, 0, 4, "",                                                                          \
+     "light projection (course §2.1.1): auto = perspective for spot, rect and disk lights, ortho for directional, " \
+     "perspective or a cube map for point and sphere lights (cube when the scene spans more than 150 degrees)",    \
+     smap_projection_names},                                                                                       \
+    {"fit", PARAM_ENUM, 0, 0, 2, "",                                                                                 \
+     "what the frustum is fitted to (course §3.2.1): the scene's bounds, the receivers the camera sees (read "     \
+     "exactly from the view samples), or none (a spot's cone, the scene's bounding sphere)",                       \
+     smap_fit_names},                                                                                              \
+    {"depth", PARAM_ENUM, 0, 0, 1, "",                                                                               \
+     "stored depth: linear (world units along the light's axis) or ndc (post-projective z in [0, 1])",             \
+     smap_depth_names},                                                                                            \
+    {"depth_bits", PARAM_ENUM, 0, 0, 2, "",                                                                          \
+     "depth storage: f32, or u24/u16 quantised over the light's depth range (course §2.1.2 on precision)",         \
+     smap_bits_names}
+
+#define SMAP_BIAS_PARAMS                                                                                           \
+    {"bias", PARAM_FLOAT, 0, 0, 1e6, "world units", "constant depth bias along the light's depth axis", NULL},      \
+    {"bias_steps", PARAM_FLOAT, 0, 0, 1e9, "depth steps",                                                            \
+     "constant bias in steps of the stored depth format at the receiver (glPolygonOffset's units)", NULL},          \
+    {"slope_bias", PARAM_FLOAT, 1, 0, 1000, "x depth slope",                                                         \
+     "slope-scaled bias (glPolygonOffset's factor): this times the receiver's depth change across one texel, "     \
+     "texel width x tan(angle to the light)",                                                                      \
+     NULL},                                                                                                        \
+    {"slope_max", PARAM_FLOAT, 8, 0, 1e6, "texels",                                                                  \
+     "clamp of the slope-scaled bias in texel widths at the receiver (tan diverges at grazing light)", NULL},      \
+    {"normal_offset", PARAM_FLOAT, 0, 0, 100, "texels",                                                              \
+     "normal-offset bias: the lookup point moves along the geometric normal by this many texel widths", NULL},     \
+    {"receiver_plane", PARAM_BOOL, 0, 0, 1, "",                                                                      \
+     "receiver-plane depth bias (Schueler 2006, course §4.1.2 box): each texel is compared with the receiver's "   \
+     "plane at that texel's centre, not with the sample's own depth",                                              \
+     NULL}
+
+enum {
+    SMAP_P_MAP_SIZE, SMAP_P_PROJECTION, SMAP_P_FIT, SMAP_P_DEPTH, SMAP_P_DEPTH_BITS,
+    SMAP_P_BIAS, SMAP_P_BIAS_STEPS, SMAP_P_SLOPE_BIAS, SMAP_P_SLOPE_MAX, SMAP_P_NORMAL_OFFSET, SMAP_P_RECEIVER_PLANE,
+    SMAP_NUM_PARAMS
+};
+
+/* The map resource the parameters ask for (first layer, no culling). */
+ShadowMapSpec smap_spec(const double *params);
+
+typedef struct SmapBias {
+    double constant_world, steps, slope, slope_max_texels, normal_offset_texels;
+    bool receiver_plane;
+    float scene_extent; /* for the engine's own offset, rt_ray_offset */
+} SmapBias;
+SmapBias smap_bias(const double *params, const Scene *scene);
+
+/* A view sample as the map sees it. */
+typedef struct SmapReceiver {
+    MapCoord mc;            /* of the (normal-offset) lookup point */
+    double texel_world;     /* texel width at the receiver, world units */
+    double ref;             /* the biased reference depth, in the map's stored metric */
+    double bias;            /* the bias subtracted, stored metric */
+    /* Receiver plane (course §4.1.2 box): the stored metric, made affine in
+     * the texel coordinates (1/depth for linear perspective maps), is
+     * g(s, t) = g0 + gs (s - s0) + gt (t - t0) on the receiver's plane. */
+    bool plane, reciprocal;
+    double g0, gs, gt;
+} SmapReceiver;
+
+/* The lookup point is first lifted off the surface along the geometric
+ * normal by rt_ray_offset, exactly as the reference and `hard` lift their
+ * shadow rays: view samples carry float error, and with zero bias a map
+ * should agree with `hard` wherever the surface faces the light squarely.
+ * false when the sample falls outside the map (the technique decides: lit). */
+bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_geom_world, SmapReceiver *r);
+
+/* Reference depth to compare with texel (i, j) of the receiver's face. */
+static inline double smap_ref_at(const SmapReceiver *r, int i, int j)
+{
+    if (!r->plane) return r->ref;
+    double g = r->g0 + r->gs * (i + 0.5 - r->mc.s) + r->gt * (j + 0.5 - r->mc.t);
+    double d = r->reciprocal ? (g > 0.0 ? 1.0 / g : INFINITY) : g;
+    return d - r->bias;
+}
+
+/* The shadow test of course §2.1: lit (1) unless the reference lies behind
+ * the stored depth; ties are lit. */
+static inline float smap_lit(const ShadowMap *m, const SmapReceiver *r, int i, int j)
+{
+    return smap_ref_at(r, i, j) > shadowmap_texel(m, r->mc.face, i, j) ? 0.0f : 1.0f;
+}
+
+/* Texel of the nearest-sample lookup. */
+static inline void smap_texel(const SmapReceiver *r, int *i, int *j)
+{
+    *i = (int)floor(r->mc.s);
+    *j = (int)floor(r->mc.t);
+}
+
+#endif
