@@ -6,9 +6,13 @@
 #include <string.h>
 
 extern const Technique tech_hard;
+extern const Technique tech_sm;
+extern const Technique tech_pcf;
 
 static const Technique *const registry[] = {
     &tech_hard,
+    &tech_sm,
+    &tech_pcf,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }
