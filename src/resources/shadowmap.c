@@ -49,6 +49,7 @@ typedef struct MapArgs {
     const Scene *scene;
     int light_index;
     ShadowMapSpec spec;
+    uint64_t key;
 } MapArgs;
 
 static int caster_meshes(const Scene *sc, RasterMesh *out)
@@ -121,6 +122,7 @@ static void *build_map(const void *args, Error *err)
     ShadowMap *m = calloc(1, sizeof *m);
     if (!m) { error_set(err, "out of memory"); return NULL; }
     m->spec = a->spec;
+    m->key = a->key;
     if (!lightview_fit(sc, &sc->lights[a->light_index], a->spec.projection, a->spec.fit, a->spec.res, vs, cls,
                        &m->view, err)) {
         free(m);
@@ -177,12 +179,12 @@ const ShadowMap *res_shadow_map(ResourceManager *rm, const Scene *scene, int lig
                   max_faces(light, spec->projection), (double)bytes / (1 << 30), (double)SHADOWMAP_MAX_BYTES / (1 << 30));
         return NULL;
     }
-    MapArgs a = {rm, scene, light_index, *spec};
+    MapArgs a = {rm, scene, light_index, *spec, map_key(scene, light_index, spec)};
     char desc[160];
     snprintf(desc, sizeof desc, "light %d, %d^2 %s, fit %s, %s %s, %s%s", light_index + 1, spec->res,
              map_projection_name(spec->projection), map_fit_name(spec->fit),
              spec->depth == RASTER_DEPTH_LINEAR ? "linear" : "ndc",
              spec->depth_bits ? (spec->depth_bits == 16 ? "16-bit" : "24-bit") : "f32", layer_name(spec->layer),
              spec->cull == RASTER_CULL_BACK ? ", back faces culled" : "");
-    return rm_acquire(rm, &kind_shadow_map, map_key(scene, light_index, spec), desc, build_map, &a, err);
+    return rm_acquire(rm, &kind_shadow_map, a.key, desc, build_map, &a, err);
 }

@@ -33,6 +33,7 @@ typedef struct ShadowMapSpec {
 } ShadowMapSpec;
 
 typedef struct ShadowMap {
+    uint64_t key;        /* its resource key: maps derived from it (moments, SATs) hash it into theirs */
     ShadowMapSpec spec;
     LightView view;
     int res, num_faces;
