@@ -23,9 +23,11 @@ TEST_SRC:= $(sort $(wildcard tests/unit/*.c))
 TEST_OBJ:= $(TEST_SRC:%.c=$(B)/obj/%.o)
 TEST_SAN:= $(TEST_SRC:%.c=$(B)/san/%.o)
 PLUGIN  := $(B)/libshadowlab_oiio.so
+# The Lua module for a plain lua5.4: require "shadowlab" with package.cpath = "build/?.so;...".
+LUAMOD  := $(B)/shadowlab.so
 
 .PHONY: all deps test test-unit demo bench docs clean FORCE
-all: $(B)/shadowlab $(PLUGIN)
+all: $(B)/shadowlab $(PLUGIN) $(LUAMOD)
 
 $(DEPS): scripts/deps.sh
 	@./scripts/deps.sh
@@ -48,11 +50,15 @@ $(B)/gen/version.h: FORCE
 	 printf '#define SHADOWLAB_COMMIT "%s"\n' "$$c" > $@.new; \
 	 cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
 $(B)/obj/src/lab/record.o $(B)/san/src/lab/record.o: $(B)/gen/version.h
+$(B)/obj/src/lua/lshadowlab.o $(B)/san/src/lua/lshadowlab.o: $(B)/gen/version.h
 
 $(B)/libshadowlab.a: $(LIB_OBJ)
 	ar rcs $@ $^
 $(B)/shadowlab: $(B)/obj/src/cli/main.o $(B)/libshadowlab.a
 	$(CC) -o $@ $^ $(LIBS)
+# lua5.4 provides Lua itself (it exports the C API): liblua is not linked in.
+$(LUAMOD): $(filter $(B)/obj/src/lua/%,$(LIB_OBJ)) $(B)/libshadowlab.a
+	$(CC) -shared -o $@ $^ $(filter-out -llua5.4,$(LIBS))
 # OpenImageIO (C++, ~280 ms to load) lives in a plugin opened on first use.
 $(PLUGIN): src/io/oiio_plugin.cpp src/io/oiio_plugin.h $(DEPS)
 	$(CXX) -std=c++17 $(OPT) -Wall -Wextra -Werror -shared -fPIC -Isrc $< -o $@ \

@@ -1,0 +1,357 @@
+-- experiment.lua -- running a sweep: the configurations (scene variants x
+-- techniques x parameter points, from the registry), a stable key for each
+-- (the engine's hash of the scene's content, light, technique and every
+-- parameter value), one Lab per scene variant so resources are reused across
+-- its configurations, a warm-up and N timed repeats per configuration, and
+-- one record row each, appended durably (records.lua). --resume skips keys
+-- already recorded; --shard I/N runs the configurations whose index modulo N
+-- is I into their own files, for `shadowlab merge`.
+local sl = package.loaded.shadowlab or require "shadowlab"
+local json = require "shadowlab.json"
+local records = require "shadowlab.records"
+
+local experiment = {}
+local Experiment = {}
+Experiment.__index = Experiment
+
+local defaults = { samples = 256, pattern = "r2", seed = 1, light = 1, repeats = 3, warmup = 1, images = true,
+                   exr = false }
+local spec_fields = { name = true, scenes = true, overrides = true, samples = true, pattern = true, seed = true,
+                      light = true, repeats = true, warmup = true, images = true, exr = true, cache = true,
+                      description = true }
+
+local function merged(a, b)
+  local m = {}
+  for k, v in pairs(a or {}) do m[k] = v end
+  for k, v in pairs(b or {}) do m[k] = v end
+  return m
+end
+
+local function sorted_pairs_text(t)
+  local keys, parts = {}, {}
+  for k in pairs(t) do keys[#keys + 1] = k end
+  table.sort(keys)
+  for i, k in ipairs(keys) do
+    local v = t[k]
+    parts[i] = k .. "=" .. (type(v) == "table" and json.encode(v) or tostring(v))
+  end
+  return table.concat(parts, " ")
+end
+
+-- experiment.new{name = "pcf-kernel", scenes = {...}, samples = 256, repeats = 3, ...}
+function experiment.new(spec)
+  if type(spec) ~= "table" then error("experiment.new expects a table", 2) end
+  for k in pairs(spec) do
+    if not spec_fields[k] then error("experiment.new: unknown field '" .. tostring(k) .. "'", 2) end
+  end
+  if type(spec.name) ~= "string" or not spec.name:match("^[%w_.-]+$") then
+    error("experiment.new: name must be letters, digits, '_', '-' or '.' (it names reports/NAME)", 2)
+  end
+  local self = setmetatable({ name = spec.name, description = spec.description, variants = {}, entries = {} },
+                            Experiment)
+  for k, v in pairs(defaults) do self[k] = spec[k] == nil and v or spec[k] end
+  self.cache, self.overrides = spec.cache, spec.overrides or {}
+  for _, s in ipairs(spec.scenes or {}) do
+    if type(s) == "table" then self:scene(s[1], s[2]) else self:scene(s) end
+  end
+  return self
+end
+
+local function exists(path)
+  local f = io.open(path, "rb")
+  if f then f:close() end
+  return f ~= nil
+end
+
+-- Scene variants: exp:scene(path) once, or with a list of override tables
+-- (e.g. sweep.grid{["lights[1].radius"] = {0.1, 0.2}}), one variant each. A
+-- relative path missing from the current folder is taken from the project.
+function Experiment:scene(path, variants)
+  if type(path) ~= "string" then error("experiment:scene expects a scene file path", 2) end
+  if not path:match("^/") and not exists(path) and exists(sl.root .. "/" .. path) then path = sl.root .. "/" .. path end
+  for _, o in ipairs(variants or { {} }) do
+    local overrides = merged(self.overrides, o)
+    self.variants[#self.variants + 1] = { file = path, overrides = overrides, swept = o,
+                                          label = sorted_pairs_text(o) }
+  end
+  return self
+end
+
+-- exp:add("pcf", sweep.grid{K = {1, 3, 5}}): a technique at each point (nil:
+-- its defaults). Names and ranges are checked now, against the registry.
+function Experiment:add(technique, points)
+  local desc = sl.technique(technique)
+  for _, p in ipairs(points or { {} }) do
+    local ok, full = pcall(sl.params, technique, p)
+    if not ok then error(full, 2) end
+    self.entries[#self.entries + 1] = { technique = desc, params = full, swept = p }
+  end
+  return self
+end
+
+-- Every registered technique (those that land later included), each at
+-- points(t) (default: its defaults); filter(t) may leave some out.
+function Experiment:add_registry(opts)
+  opts = opts or {}
+  for _, t in ipairs(sl.techniques()) do
+    if not opts.filter or opts.filter(t) then self:add(t.name, opts.points and opts.points(t) or nil) end
+  end
+  return self
+end
+
+---------------------------------------------------------------- arguments
+
+local usage = [[
+experiment options:
+  --out DIR        results folder (default reports/NAME)
+  --resume         continue the results in --out, skipping configurations already recorded
+  --fresh          discard the results in --out and start again
+  --shard I/N      run only configurations whose index modulo N is I (0 <= I < N), into their own files
+  --threads N      worker threads
+  --repeats N      timed evaluations per configuration (median and minimum recorded)
+  --warmup N       untimed evaluations before them
+  --samples N      reference light samples per view sample
+  --no-images      no PNG images per configuration (smaller, faster; the report shows plots only)
+  --quiet          no progress lines]]
+
+local function usage_error(msg)
+  io.stderr:write("error: ", msg, "\n", usage, "\n")
+  os.exit(2)
+end
+
+local function int_arg(argv, i, name, lo, hi)
+  local v = math.tointeger(tonumber(argv[i + 1] or ""))
+  if not v or v < lo or v > hi then usage_error(string.format("%s expects an integer in [%d, %d]", name, lo, hi)) end
+  return v
+end
+
+-- Parse the script's arguments (arg); bad ones print usage and exit 2.
+function experiment.parse_args(argv)
+  local o, i = { shard = { index = 0, count = 1 } }, 1
+  while argv and argv[i] do
+    local a = argv[i]
+    if a == "--out" then o.out = argv[i + 1] or usage_error("--out expects a folder"); i = i + 1
+    elseif a == "--resume" then o.resume = true
+    elseif a == "--fresh" then o.fresh = true
+    elseif a == "--no-images" then o.images = false
+    elseif a == "--quiet" then o.quiet = true
+    elseif a == "--shard" then
+      local si, sn = (argv[i + 1] or ""):match("^(%d+)/(%d+)$")
+      si, sn = math.tointeger(tonumber(si)), math.tointeger(tonumber(sn))
+      if not si or sn < 1 or si >= sn then usage_error("--shard expects I/N with 0 <= I < N") end
+      o.shard = { index = si, count = sn }
+      i = i + 1
+    elseif a == "--threads" then o.threads = int_arg(argv, i, a, 1, 1024); i = i + 1
+    elseif a == "--repeats" then o.repeats = int_arg(argv, i, a, 1, 10000); i = i + 1
+    elseif a == "--warmup" then o.warmup = int_arg(argv, i, a, 0, 1000); i = i + 1
+    elseif a == "--samples" then o.samples = int_arg(argv, i, a, 1, 1048576); i = i + 1
+    elseif a == "--help" or a == "-h" then io.stdout:write(usage, "\n"); os.exit(0)
+    else usage_error("unknown argument '" .. tostring(a) .. "'") end
+    i = i + 1
+  end
+  if o.resume and o.fresh then usage_error("--resume and --fresh exclude each other") end
+  return o
+end
+
+---------------------------------------------------------------- configurations
+
+local function technique_handles(desc, light_type)
+  for _, l in ipairs(desc.lights) do
+    if l == light_type then return true end
+  end
+  return false
+end
+
+local function point_label(entry)
+  local text = sorted_pairs_text(entry.swept)
+  return entry.technique.name .. (text ~= "" and " " .. text or "")
+end
+
+-- Open every variant's Lab and list the configurations in a fixed order
+-- (variants, then techniques, then points). A technique is left out of a
+-- variant whose light it does not handle (the registry says which).
+function Experiment:configurations()
+  local configs = {}
+  for vi, v in ipairs(self.variants) do
+    v.lab = v.lab or sl.open(v.file, v.overrides)
+    v.info = v.lab:info()
+    local light = v.info.lights[self.light]
+    if not light then error(string.format("%s has no light %d", v.file, self.light), 0) end
+    for _, e in ipairs(self.entries) do
+      if technique_handles(e.technique, light.type) then
+        local key = v.lab:key(e.technique.name, e.params, self.light)
+        configs[#configs + 1] = { index = #configs, variant = v, variant_index = vi, entry = e, key = key,
+                                  label = point_label(e) }
+      end
+    end
+  end
+  return configs
+end
+
+function Experiment:settings()
+  return { samples = self.samples, pattern = self.pattern, seed = self.seed, light = self.light,
+           repeats = self.repeats, warmup = self.warmup, measure = "visibility" }
+end
+
+-- The CSV columns: the standard ones, then every parameter of the
+-- techniques and every scene override that the experiment sets.
+function Experiment:columns()
+  local columns, seen = {}, {}
+  for _, c in ipairs(records.standard_columns) do columns[#columns + 1] = c[1] end
+  local function add(name)
+    if not seen[name] then
+      seen[name] = true
+      columns[#columns + 1] = name
+    end
+  end
+  for _, e in ipairs(self.entries) do
+    for _, p in ipairs(e.technique.params) do add("param:" .. p.name) end
+  end
+  local keys = {}
+  for _, v in ipairs(self.variants) do
+    for k in pairs(v.overrides) do keys[#keys + 1] = k end
+  end
+  table.sort(keys)
+  for _, k in ipairs(keys) do add("scene:" .. k) end
+  return columns
+end
+
+---------------------------------------------------------------- running
+
+local function file_names(out, shard)
+  if shard.count == 1 then return out .. "/records.jsonl", out .. "/results.csv" end
+  local tag = string.format("shard-%d-of-%d", shard.index, shard.count)
+  return out .. "/records." .. tag .. ".jsonl", out .. "/results." .. tag .. ".csv"
+end
+
+function Experiment:open_results(o, configs)
+  local jsonl, csv = file_names(o.out, o.shard)
+  if exists(jsonl) and not o.resume then
+    if not o.fresh then
+      error(jsonl .. " exists: pass --resume to continue it, --fresh to start again, or another --out", 0)
+    end
+    os.remove(jsonl)
+    os.remove(csv)
+  end
+  sl.mkdir(o.out)
+  local settings = self:settings()
+  local header = { shadowlab_results = 1, name = self.name, settings = settings,
+                   fingerprint = sl.hash(json.encode({ name = self.name, settings = settings })),
+                   shard = o.shard, configurations = #configs, columns = self:columns() }
+  return records.open(jsonl, csv, header), header
+end
+
+local function image_paths(config)
+  local dir = "images/" .. config.key
+  local t = config.entry.technique.name
+  return { dir = dir, visibility = dir .. "/" .. t .. ".png", shaded = dir .. "/" .. t .. "-shaded.png",
+           error = dir .. "/" .. t .. "-error.png",
+           reference = "images/ref-" .. config.variant.info.hash .. "/reference.png",
+           reference_shaded = "images/ref-" .. config.variant.info.hash .. "/reference-shaded.png" }
+end
+
+function Experiment:compare_options(config, out_dir)
+  return { technique = config.entry.technique.name, params = config.entry.params, light = self.light,
+           repeats = self.repeats, warmup = self.warmup, samples = self.samples, pattern = self.pattern,
+           seed = self.seed, cache = self.cache, out = out_dir, exr = self.exr }
+end
+
+-- The reference's images for a variant, once per results folder.
+function Experiment:reference_images(config, out)
+  local paths = image_paths(config)
+  if exists(out .. "/" .. paths.reference) then return end
+  config.variant.lab:reference{ light = self.light, samples = self.samples, pattern = self.pattern,
+                                seed = self.seed, cache = self.cache, exr = false,
+                                out = out .. "/" .. paths.reference:match("^(.*)/") }
+end
+
+function Experiment:run_one(config, o, header)
+  local row = { index = config.index, key = config.key, label = config.label, experiment = header.fingerprint,
+                technique = config.entry.technique.name, params = config.entry.params,
+                variant = { scene = config.variant.info.name, file = config.variant.file,
+                            overrides = config.variant.overrides, label = config.variant.label } }
+  local paths = o.images and image_paths(config) or nil
+  local ok, run = pcall(function()
+    local r = config.variant.lab:compare(self:compare_options(config, paths and o.out .. "/" .. paths.dir))
+    if paths then self:reference_images(config, o.out) end
+    return r
+  end)
+  if ok then
+    row.status, row.record = "ok", run:record()
+    if paths then row.images = paths; row.images.dir = nil end
+  else
+    row.status, row.error = "error", tostring(run)
+  end
+  return row
+end
+
+local function progress(o, n, total, config, row)
+  if o.quiet then return end
+  local v = config.variant
+  local where = v.info.name .. (v.label ~= "" and " [" .. v.label .. "]" or "")
+  if row.status ~= "ok" then
+    io.stderr:write(string.format("[%d/%d] %s on %s: ERROR %s\n", n, total, config.label, where, row.error))
+    return
+  end
+  local m, t = row.record.metrics, row.record.timings_s
+  io.stderr:write(string.format("[%d/%d] %s on %s: rmse %.5f, frame %.3f ms (eval %.3f ms, %s)\n", n, total,
+                                config.label, where, m.all.rmse, 1e3 * t.frame, 1e3 * t.evaluate_median,
+                                row.record.resource_cache))
+end
+
+-- Run the experiment with the script's arguments. Returns a result table:
+-- rows (this output's rows in configuration order), out, sharded, computed,
+-- skipped, failed, the experiment and its header.
+function Experiment:run(argv)
+  local o = experiment.parse_args(argv)
+  o.out = o.out or ("reports/" .. self.name)
+  if o.images == nil then o.images = self.images end
+  for _, k in ipairs({ "repeats", "warmup", "samples" }) do
+    if o[k] then self[k] = o[k] end
+  end
+  if o.threads then sl.threads(o.threads) end
+  if #self.entries == 0 then error("experiment " .. self.name .. ": no techniques added", 0) end
+  if #self.variants == 0 then error("experiment " .. self.name .. ": no scenes", 0) end
+  local configs = self:configurations()
+  local writer, header = self:open_results(o, configs)
+  local result = { experiment = self, header = header, out = o.out, sharded = o.shard.count > 1, rows = {},
+                   computed = 0, skipped = 0, failed = 0, dropped = writer.dropped }
+  if writer.dropped > 0 and not o.quiet then
+    io.stderr:write(string.format("%s: dropped a half-written last row\n", writer.path))
+  end
+  local mine = {}
+  for _, c in ipairs(configs) do
+    if c.index % o.shard.count == o.shard.index then mine[#mine + 1] = c end
+  end
+  local last_use = {}
+  for i, c in ipairs(mine) do last_use[c.variant] = i end
+  for i, c in ipairs(mine) do
+    local row = writer.done[c.key]
+    if row then
+      result.skipped = result.skipped + 1
+    else
+      row = self:run_one(c, o, header)
+      writer:append(row)
+      result.computed = result.computed + 1
+      progress(o, i, #mine, c, row)
+      if self.on_row then self.on_row(row) end
+    end
+    if row.status ~= "ok" then result.failed = result.failed + 1 end
+    result.rows[#result.rows + 1] = row
+    if last_use[c.variant] == i then
+      c.variant.lab:close()
+      c.variant.lab = nil
+    end
+  end
+  writer:close()
+  for _, v in ipairs(self.variants) do
+    if v.lab then v.lab:close(); v.lab = nil end
+  end
+  if not o.quiet then
+    io.stderr:write(string.format("%s: %d computed, %d already recorded, %d failed -> %s\n", self.name,
+                                  result.computed, result.skipped, result.failed, writer.path))
+  end
+  return result
+end
+
+return experiment

@@ -1,0 +1,168 @@
+-- html.lua -- the report's index.html: one file with its style inline and
+-- only relative links (plots, images, results.csv, records.jsonl), so it
+-- opens from disk and from any copy of the folder. A small inline script
+-- checks on load that every image arrived and says so at the top of the page
+-- (the browser test reads that line).
+local sl = package.loaded.shadowlab or require "shadowlab"
+
+local html = {}
+
+local function esc(s)
+  return (tostring(s):gsub("[&<>\"']", { ["&"] = "&amp;", ["<"] = "&lt;", [">"] = "&gt;", ['"'] = "&quot;",
+                                         ["'"] = "&#39;" }))
+end
+html.escape = esc
+
+local style = [[
+body { font: 14px/1.45 sans-serif; margin: 1.5em auto; max-width: 1200px; padding: 0 1em; color: #222; }
+h1 { font-size: 1.6em; } h2 { margin-top: 2em; border-bottom: 1px solid #ccc; } h3 { margin-bottom: .3em; }
+table { border-collapse: collapse; font-size: 12px; } td, th { border: 1px solid #ddd; padding: 2px 6px; }
+th { background: #f3f3f3; } td.n { text-align: right; font-variant-numeric: tabular-nums; }
+tr.front td { background: #eef7ee; } tr.err td { background: #fbeaea; }
+.plots { display: grid; grid-template-columns: repeat(auto-fill, minmax(480px, 1fr)); gap: 8px; }
+.plots img { width: 100%; border: 1px solid #eee; }
+.grid { display: grid; grid-template-columns: repeat(auto-fill, minmax(220px, 1fr)); gap: 10px; }
+.grid figure { margin: 0; font-size: 11px; } .grid img { width: 100%; image-rendering: pixelated; }
+.ref { outline: 3px solid #444; } #load-status { font-weight: bold; } .note { color: #555; }
+]]
+
+local check_script = [[
+<script>
+window.addEventListener("load", function () {
+  var imgs = document.images, missing = [];
+  for (var i = 0; i < imgs.length; i++)
+    if (!imgs[i].complete || imgs[i].naturalWidth === 0) missing.push(imgs[i].getAttribute("src"));
+  var s = document.getElementById("load-status");
+  s.setAttribute("data-images", String(imgs.length));
+  s.setAttribute("data-missing", String(missing.length));
+  s.textContent = missing.length ? "images missing: " + missing.join(", ") : "all " + imgs.length + " images loaded";
+});
+</script>
+]]
+
+local function num(v, fmt)
+  if type(v) ~= "number" then return "" end
+  return string.format(fmt, v)
+end
+
+local function params_text(r)
+  local keys, parts = {}, {}
+  for k in pairs(r.params or {}) do keys[#keys + 1] = k end
+  table.sort(keys)
+  for i, k in ipairs(keys) do parts[i] = k .. "=" .. tostring(r.params[k]) end
+  return table.concat(parts, " ")
+end
+
+local function results_table(doc, out)
+  out[#out + 1] = "<table><tr><th>#</th><th>scene</th><th>configuration</th><th>" .. esc(doc.err_label) ..
+                  "</th><th>penumbra RMSE</th><th>MAE</th><th>&gt;0.5</th><th>noise rms</th><th>" ..
+                  esc(doc.time_label) .. " ms</th><th>eval median ms</th><th>eval min ms</th>" ..
+                  "<th>build ms</th><th>resources</th><th>reference</th><th>all parameters</th></tr>"
+  for _, r in ipairs(doc.rows) do
+    local where = esc(r.variant.scene .. (r.variant.label ~= "" and " [" .. r.variant.label .. "]" or ""))
+    if r.status ~= "ok" then
+      out[#out + 1] = string.format('<tr class="err"><td class="n">%d</td><td>%s</td><td>%s</td><td colspan="12">%s</td></tr>',
+                                    r.index, where, esc(r.label), esc(r.error or "failed"))
+    else
+      local m, t, rec = r.record.metrics, r.record.timings_s, r.record
+      out[#out + 1] = string.format(
+        '<tr%s><td class="n">%d</td><td>%s</td><td>%s</td><td class="n">%s</td><td class="n">%s</td>' ..
+        '<td class="n">%s</td><td class="n">%s</td><td class="n">%s</td><td class="n">%s</td><td class="n">%s</td>' ..
+        '<td class="n">%s</td><td class="n">%s</td><td>%s</td><td>%s</td><td>%s</td></tr>',
+        r.on_front and ' class="front"' or "", r.index, where, esc(r.label), num(doc.err(r), "%.5f"),
+        num(m.penumbra.rmse, "%.5f"), num(m.all.mae, "%.5f"), num(m.all.misclassified, "%.4f"),
+        num(m.noise_rms, "%.5f"), num(1e3 * t[doc.time], "%.3f"), num(1e3 * t.evaluate_median, "%.3f"),
+        num(1e3 * t.evaluate_min, "%.3f"), num(1e3 * t.technique_build, "%.3f"), esc(rec.resource_cache),
+        esc(rec.reference.origin), esc(params_text(r)))
+    end
+  end
+  out[#out + 1] = "</table>"
+end
+
+local function plot_block(p, out)
+  if not p then return end
+  out[#out + 1] = string.format('<p><img src="%s" alt="%s"><br><a href="%s">PNG</a> · <a href="%s">SVG</a></p>',
+                                esc(p.svg), esc(p.svg), esc(p.png), esc(p.svg))
+end
+
+local function figure(src, caption, class)
+  return string.format('<figure><img src="%s" alt="%s"%s><figcaption>%s</figcaption></figure>', esc(src),
+                       esc(caption), class and ' class="' .. class .. '"' or "", caption)
+end
+
+-- The images of one scene variant: the reference first, then every
+-- configuration's visibility and signed error.
+local function image_grid(entry, doc, out)
+  local first = entry.rows[1]
+  if not first.images then return end
+  out[#out + 1] = '<div class="grid">'
+  out[#out + 1] = figure(first.images.reference, "reference (" .. esc(first.record.reference.samples) ..
+                         " samples)", "ref")
+  out[#out + 1] = figure(first.images.reference_shaded, "reference, shaded", "ref")
+  for _, r in ipairs(entry.rows) do
+    local cap = esc(r.label) .. ": " .. esc(doc.err_label) .. " " .. num(doc.err(r), "%.4f")
+    out[#out + 1] = figure(r.images.visibility, cap)
+    out[#out + 1] = figure(r.images.error, esc(r.label) .. ": signed error, ±" ..
+                           num(r.record.metrics.error_png_scale, "%g") .. " (blue too dark, red leaking)")
+  end
+  out[#out + 1] = "</div>"
+end
+
+local function machine_text(doc)
+  local r = doc.ok_rows[1]
+  if not r then return "no successful configuration" end
+  local m = r.record.machine
+  return string.format("%s (%s, %s), %d threads, commit %s", esc(m.cpu), esc(m.host), esc(m.arch),
+                       m.threads, esc(m.commit))
+end
+
+local definitions = [[
+<p class="note"><b>Frame time</b> = the build time of every resource the technique's prepare depends
+on (a shadow map is re-rendered each frame in a renderer, so its logged build time counts even when this
+run reused it), plus the prepare's own set-up, plus the median of the timed evaluations (after the
+warm-up). It leaves out the engine's view samples (a renderer's G-buffer) and the reference.
+<b>Error</b> is measured over light-facing, non-background view samples against the Embree reference;
+the reference's own noise (rms of its standard errors) is shown beside it, and errors near it are not
+resolved. Resource build and evaluation times are listed separately; "cold" means this configuration
+built a resource, "warm" that it reused every one.</p>
+]]
+
+function html.write_index(path, doc)
+  local res, h = doc.result, doc.result.header
+  local s = h.settings
+  local out = { "<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
+                "<title>" .. esc(doc.opts.title or h.name) .. "</title>", "<style>" .. style .. "</style>",
+                "</head><body>" }
+  out[#out + 1] = "<h1>" .. esc(doc.opts.title or h.name) .. "</h1>"
+  if res.experiment.description then out[#out + 1] = "<p>" .. esc(res.experiment.description) .. "</p>" end
+  out[#out + 1] = '<p id="load-status">checking images…</p>'
+  out[#out + 1] = string.format("<p>Experiment <code>%s</code> (fingerprint %s): %d configurations, %d failed. " ..
+                                "Reference: %d %s light samples, seed %d, light %d. Timing: %d warm-up + %d " ..
+                                "timed evaluations. Machine: %s.</p>", esc(h.name), esc(h.fingerprint),
+                                #doc.rows, #doc.rows - #doc.ok_rows, s.samples, esc(s.pattern), s.seed, s.light,
+                                s.warmup, s.repeats, machine_text(doc))
+  out[#out + 1] = '<p>Data: <a href="results.csv">results.csv</a> · <a href="records.jsonl">records.jsonl</a> ' ..
+                  "(one JSON record per configuration, with every parameter, timing and resource).</p>"
+  out[#out + 1] = definitions
+  out[#out + 1] = "<h2>" .. esc(doc.err_label) .. " against " .. esc(doc.time_label) .. "</h2><div class=\"plots\">"
+  for _, p in ipairs(doc.plots.time) do plot_block(p.file, out) end
+  out[#out + 1] = "</div>"
+  if #doc.plots.axes > 0 then
+    out[#out + 1] = "<h2>Against the swept parameters</h2><div class=\"plots\">"
+    for _, p in ipairs(doc.plots.axes) do plot_block(p.file, out) end
+    out[#out + 1] = "</div>"
+  end
+  out[#out + 1] = "<h2>Results</h2><p class=\"note\">Green rows are on the Pareto front of their scene.</p>"
+  results_table(doc, out)
+  out[#out + 1] = "<h2>Images beside the reference</h2>"
+  for _, p in ipairs(doc.plots.time) do
+    local v = p.variant
+    out[#out + 1] = "<h3>" .. esc(v.scene .. (v.label ~= "" and " [" .. v.label .. "]" or "")) .. "</h3>"
+    image_grid(p, doc, out)
+  end
+  out[#out + 1] = check_script
+  out[#out + 1] = "</body></html>"
+  sl.write_file(path, table.concat(out, "\n") .. "\n")
+end
+
+return html

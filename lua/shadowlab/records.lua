@@ -1,0 +1,237 @@
+-- records.lua -- a sweep's results on disk: JSON Lines (a header line, then
+-- one row per configuration) and the same rows as CSV. Each row is appended
+-- with a single write, then flushed and fsynced, so a sweep killed at any
+-- point (Ctrl-C, kill -9, power loss) keeps every finished row; a half-written
+-- last row (no newline) is detected on reading and dropped. The CSV is
+-- rewritten from the JSON Lines whenever a results file is reopened.
+local sl = package.loaded.shadowlab or require "shadowlab"
+local json = require "shadowlab.json"
+
+local records = {}
+
+---------------------------------------------------------------- reading
+
+-- header, rows, dropped (half-written rows dropped) of a results file; nil
+-- when the file does not exist. A malformed complete line is an error naming
+-- the file and line (an append-only writer cannot leave one mid-file).
+function records.read(path)
+  local f = io.open(path, "rb")
+  if not f then return nil end
+  local text = f:read("a")
+  f:close()
+  local lines, dropped, pos = {}, 0, 1
+  while pos <= #text do
+    local nl = text:find("\n", pos, true)
+    if not nl then
+      dropped = 1
+      break
+    end
+    lines[#lines + 1] = text:sub(pos, nl - 1)
+    pos = nl + 1
+  end
+  if #lines == 0 then
+    error(string.format("%s: no header line (an empty or truncated results file)", path), 0)
+  end
+  local decoded = {}
+  for i, line in ipairs(lines) do
+    local ok, value = pcall(json.decode, line)
+    if not ok or type(value) ~= "table" then
+      error(string.format("%s:%d: %s", path, i, ok and "not a JSON object" or value), 0)
+    end
+    decoded[i] = value
+  end
+  local header = table.remove(decoded, 1)
+  if header.shadowlab_results ~= 1 then
+    error(string.format("%s:1: not a shadowlab results file (no shadowlab_results header)", path), 0)
+  end
+  for i, row in ipairs(decoded) do
+    if type(row.key) ~= "string" then error(string.format("%s:%d: row without a key", path, i + 1), 0) end
+  end
+  return header, decoded, dropped
+end
+
+---------------------------------------------------------------- CSV
+
+-- Column name -> value of a row. Names "param:NAME" and "scene:KEY" read the
+-- technique's parameter and the scene variant's override.
+local function metric(region, field)
+  return function(r) return r.record and r.record.metrics and r.record.metrics[region] and r.record.metrics[region][field] end
+end
+local function timing(field)
+  return function(r) return r.record and r.record.timings_s and r.record.timings_s[field] end
+end
+local function record_field(a, b)
+  return function(r) return r.record and r.record[a] and r.record[a][b] end
+end
+
+records.standard_columns = {
+  { "index", function(r) return r.index end },
+  { "key", function(r) return r.key end },
+  { "status", function(r) return r.status end },
+  { "scene", function(r) return r.variant and r.variant.scene end },
+  { "variant", function(r) return r.variant and r.variant.label end },
+  { "technique", function(r) return r.technique end },
+  { "label", function(r) return r.label end },
+  { "width", record_field("scene", "width") },
+  { "height", record_field("scene", "height") },
+  { "frame_s", timing("frame") },
+  { "eval_median_s", timing("evaluate_median") },
+  { "eval_min_s", timing("evaluate_min") },
+  { "prepare_s", timing("prepare") },
+  { "technique_build_s", timing("technique_build") },
+  { "view_samples_s", timing("view_samples") },
+  { "repeats", timing("repeat") },
+  { "warmup", timing("warmup") },
+  { "resource_cache", function(r) return r.record and r.record.resource_cache end },
+  { "reference_origin", record_field("reference", "origin") },
+  { "reference_samples", record_field("reference", "samples") },
+  { "noise_rms", record_field("metrics", "noise_rms") },
+  { "rmse", metric("all", "rmse") },
+  { "rmse_debiased", record_field("metrics", "rmse_debiased") },
+  { "resolved", record_field("metrics", "resolved") },
+  { "mae", metric("all", "mae") },
+  { "max_abs", metric("all", "max_abs") },
+  { "mean_signed", metric("all", "mean_signed") },
+  { "leak", metric("all", "leak_mean") },
+  { "dark", metric("all", "dark_mean") },
+  { "misclassified", metric("all", "misclassified") },
+  { "penumbra_rmse", metric("penumbra", "rmse") },
+  { "umbra_rmse", metric("umbra", "rmse") },
+  { "lit_rmse", metric("lit", "rmse") },
+  { "false_shadow", record_field("metrics", "false_shadow") },
+  { "false_lit", record_field("metrics", "false_lit") },
+  { "threads", record_field("machine", "threads") },
+  { "host", record_field("machine", "host") },
+  { "error", function(r) return r.error end },
+}
+
+local standard_getter = {}
+for _, c in ipairs(records.standard_columns) do standard_getter[c[1]] = c[2] end
+
+function records.column_value(name, row)
+  if standard_getter[name] then return standard_getter[name](row) end
+  local param = name:match("^param:(.+)$")
+  if param then return row.params and row.params[param] end
+  local override = name:match("^scene:(.+)$")
+  if override then return row.variant and row.variant.overrides and row.variant.overrides[override] end
+  error("records: unknown column " .. name, 2)
+end
+
+local function csv_field(v)
+  if v == nil or v == json.null then return "" end
+  if type(v) == "table" then v = json.encode(v) end
+  if math.type(v) == "float" then v = string.format("%.9g", v) end
+  local s = tostring(v)
+  if s:find('[,"\n\r]') then s = '"' .. s:gsub('"', '""') .. '"' end
+  return s
+end
+
+function records.csv_line(columns, row)
+  local out = {}
+  for i, name in ipairs(columns) do out[i] = csv_field(records.column_value(name, row)) end
+  return table.concat(out, ",") .. "\n"
+end
+
+function records.csv_text(columns, rows)
+  local parts = { table.concat(columns, ",") .. "\n" }
+  for _, row in ipairs(rows) do parts[#parts + 1] = records.csv_line(columns, row) end
+  return table.concat(parts)
+end
+
+---------------------------------------------------------------- writing
+
+local Writer = {}
+Writer.__index = Writer
+
+local function open_append(path)
+  local f, msg = io.open(path, "ab")
+  if not f then error(msg, 0) end
+  f:setvbuf("full", 1 << 22) -- a row goes out in one write()
+  return f
+end
+
+local function folder_of(path) return path:match("^(.*)/[^/]*$") or "." end
+
+local function file_text(header, rows)
+  local lines = { json.encode(header) }
+  for i, row in ipairs(rows) do lines[i + 1] = json.encode(row) end
+  return table.concat(lines, "\n") .. "\n"
+end
+
+-- Open the results `jsonl_path` (and its CSV `csv_path`) for appending.
+-- A new file starts with `header`. An existing one must carry the same
+-- header.fingerprint (the same experiment), else it is refused; its rows
+-- are kept (writer.rows, writer.done[key]) and a half-written last row is
+-- dropped (writer.dropped = 1). CSV columns come from header.columns.
+function records.open(jsonl_path, csv_path, header)
+  local w = setmetatable({ path = jsonl_path, csv_path = csv_path, columns = header.columns,
+                           rows = {}, done = {}, dropped = 0 }, Writer)
+  local old, rows, dropped = records.read(jsonl_path)
+  if old then
+    if old.fingerprint ~= header.fingerprint then
+      error(string.format("%s holds experiment '%s' (fingerprint %s, settings %s); this run is '%s' (%s, %s): " ..
+                          "use another --out, or --fresh to discard it", jsonl_path, tostring(old.name),
+                          tostring(old.fingerprint), json.encode(old.settings or {}), header.name,
+                          header.fingerprint, json.encode(header.settings)), 0)
+    end
+    w.rows, w.dropped = rows, dropped
+    if dropped > 0 then sl.write_file(jsonl_path, file_text(old, rows)) end
+  else
+    sl.write_file(jsonl_path, file_text(header, {}))
+    sl.fsync_dir(folder_of(jsonl_path))
+  end
+  for _, row in ipairs(w.rows) do w.done[row.key] = row end
+  sl.write_file(csv_path, records.csv_text(w.columns, w.rows))
+  w.jsonl, w.csv = open_append(jsonl_path), open_append(csv_path)
+  return w
+end
+
+-- Append one row to both files, each written, flushed and fsynced.
+function Writer:append(row)
+  if self.done[row.key] then error("records: configuration " .. row.key .. " is already recorded", 2) end
+  self.jsonl:write(json.encode(row), "\n")
+  sl.fsync(self.jsonl)
+  self.csv:write(records.csv_line(self.columns, row))
+  sl.fsync(self.csv)
+  self.rows[#self.rows + 1] = row
+  self.done[row.key] = row
+end
+
+function Writer:close()
+  if self.jsonl then self.jsonl:close() end
+  if self.csv then self.csv:close() end
+  self.jsonl, self.csv = nil, nil
+end
+
+---------------------------------------------------------------- comparing
+
+-- A row without what differs between two runs of the same configuration:
+-- timings, resource build/reuse, cache states, machine, output paths. Two
+-- runs agree when their comparable rows encode to the same JSON.
+local run_specific = {
+  record = { timings_s = true, resources = true, technique_resources = true, resource_cache = true,
+             machine = true },
+  reference = { origin = true, seconds = true, rays_per_second = true, cache_path = true, cache_note = true },
+}
+
+function records.comparable(row)
+  local copy = {}
+  for k, v in pairs(row) do copy[k] = v end
+  if row.record then
+    local rec = {}
+    for k, v in pairs(row.record) do
+      if not run_specific.record[k] then rec[k] = v end
+    end
+    if rec.reference then
+      local ref = {}
+      for k, v in pairs(rec.reference) do
+        if not run_specific.reference[k] then ref[k] = v end
+      end
+      rec.reference = ref
+    end
+    copy.record = rec
+  end
+  return copy
+end
+
+return records

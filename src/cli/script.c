@@ -1,0 +1,147 @@
+/* script.c -- `shadowlab run [--threads N] SCRIPT.lua [ARGS...]`: a Lua 5.4
+ * interpreter with the shadowlab module loaded (src/lua/), the project's lua/
+ * folder on package.path, and `arg` set as lua5.4 sets it (arg[0] the
+ * script, arg[1..] its arguments). A Lua error exits 1 with its message and
+ * a traceback. The same interpreter runs the Lua side of `merge`. */
+#include <lauxlib.h>
+#include <limits.h>
+#include <lualib.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "cli/cli.h"
+#include "lua/sl_lua.h"
+
+/* ROOT = the folder above the executable's (build/shadowlab -> .). */
+static void set_project_root(void)
+{
+    char exe[PATH_MAX], root[PATH_MAX + 4];
+    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (len <= 0) return;
+    exe[len] = '\0';
+    char *slash = strrchr(exe, '/');
+    if (!slash) return;
+    *slash = '\0';
+    snprintf(root, sizeof root, "%s/..", exe);
+    if (realpath(root, exe)) sl_lua_set_root(exe);
+}
+
+static int traceback(lua_State *L)
+{
+    const char *msg = lua_tostring(L, 1);
+    if (!msg) msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
+    luaL_traceback(L, L, msg, 1);
+    return 1;
+}
+
+/* arg = {[0] = script, args...} */
+static void set_args(lua_State *L, const char *script, int argc, char **argv)
+{
+    lua_createtable(L, argc, 1);
+    lua_pushstring(L, script);
+    lua_rawseti(L, -2, 0);
+    for (int i = 0; i < argc; i++) {
+        lua_pushstring(L, argv[i]);
+        lua_rawseti(L, -2, i + 1);
+    }
+    lua_setglobal(L, "arg");
+}
+
+/* Call the function on top of the stack with `arg`'s elements; the exit
+ * status is an integer it returns, else 0; errors print and give 1. */
+static int call_main(lua_State *L, const char *command, int argc, char **argv)
+{
+    int fn = lua_gettop(L);
+    lua_pushcfunction(L, traceback);
+    lua_insert(L, fn);
+    luaL_checkstack(L, argc, "too many arguments");
+    for (int i = 0; i < argc; i++) lua_pushstring(L, argv[i]);
+    if (lua_pcall(L, argc, 1, fn) != LUA_OK) {
+        fprintf(stderr, "shadowlab %s: %s\n", command, lua_tostring(L, -1));
+        return EXIT_RUNTIME;
+    }
+    return lua_isinteger(L, -1) ? (int)lua_tointeger(L, -1) : EXIT_OK;
+}
+
+static lua_State *open_state(void)
+{
+    lua_State *L = luaL_newstate();
+    if (!L) return NULL;
+    luaL_openlibs(L);
+    set_project_root();
+    luaL_requiref(L, "shadowlab", luaopen_shadowlab, 0);
+    lua_pop(L, 1);
+    return L;
+}
+
+int cli_lua_module_main(const char *command, const char *module, int argc, char **argv)
+{
+    lua_State *L = open_state();
+    if (!L) {
+        fprintf(stderr, "shadowlab %s: cannot create a Lua state (out of memory)\n", command);
+        return EXIT_RUNTIME;
+    }
+    set_args(L, command, argc, argv);
+    lua_getglobal(L, "require");
+    lua_pushstring(L, module);
+    int status = lua_pcall(L, 1, 1, 0);
+    if (status == LUA_OK) lua_getfield(L, -1, "main");
+    if (status != LUA_OK || !lua_isfunction(L, -1)) {
+        fprintf(stderr, "shadowlab %s: cannot load %s: %s\n", command, module,
+                status != LUA_OK ? lua_tostring(L, -1) : "it has no main function");
+        lua_close(L);
+        return EXIT_RUNTIME;
+    }
+    status = call_main(L, command, argc, argv);
+    lua_close(L);
+    return status;
+}
+
+static const char *const run_help =
+    "usage: shadowlab run [--threads N] SCRIPT.lua [ARGS...]\n"
+    "  runs a Lua 5.4 script with `require \"shadowlab\"` and the helpers in lua/shadowlab/\n"
+    "  (sweep, experiment, records, report, pareto, autotune) available; ARGS are in `arg`.\n"
+    "  Experiments take: --out DIR --resume --fresh --shard I/N --threads N --repeats N\n"
+    "  --warmup N --samples N --no-images (see README, \"The Lua lab\").\n";
+
+int cmd_run(int argc, char **argv)
+{
+    int i = 1, threads = 0;
+    for (; i < argc && argv[i][0] == '-'; i++) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            fputs(run_help, stdout);
+            return EXIT_OK;
+        }
+        char *end = NULL;
+        long n = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : 0;
+        if (strcmp(argv[i], "--threads") != 0 || !end || *end || n < 1 || n > 1024) {
+            fprintf(stderr, "shadowlab run: %s: expected --threads N (N in [1, 1024]) or --help before SCRIPT\n",
+                    argv[i]);
+            return EXIT_USAGE;
+        }
+        threads = (int)n;
+        i++;
+    }
+    if (i >= argc) {
+        fprintf(stderr, "shadowlab run: missing SCRIPT.lua\n%s", run_help);
+        return EXIT_USAGE;
+    }
+    CliOptions o = {.threads = threads};
+    cli_apply_threads(&o);
+    lua_State *L = open_state();
+    if (!L) {
+        fprintf(stderr, "shadowlab run: cannot create a Lua state (out of memory)\n");
+        return EXIT_RUNTIME;
+    }
+    const char *script = argv[i];
+    set_args(L, script, argc - i - 1, argv + i + 1);
+    int status;
+    if (luaL_loadfile(L, script) != LUA_OK) {
+        fprintf(stderr, "shadowlab run: %s\n", lua_tostring(L, -1));
+        status = EXIT_RUNTIME;
+    } else {
+        status = call_main(L, "run", argc - i - 1, argv + i + 1);
+    }
+    lua_close(L);
+    return status;
+}
