@@ -16,10 +16,11 @@ trap 'rm -f "$log"' EXIT
 "./$B/test_unit_san" 2>&1 | tee "$log"
 unit_status=$?
 SHADOWLAB_CACHE=$(mktemp -d) ./tests/cli/run.sh "$B/shadowlab" 2>&1 | tee -a "$log"
+./tests/lua/run.sh "$B/shadowlab" 2>&1 | tee -a "$log"
 passed=$(sed -n 's/^[a-z]*: \([0-9]*\) passed, \([0-9]*\) failed$/\1/p' "$log" | awk '{s+=$1} END {print s+0}')
 failed=$(sed -n 's/^[a-z]*: \([0-9]*\) passed, \([0-9]*\) failed$/\2/p' "$log" | awk '{s+=$1} END {print s+0}')
 suites=$(grep -c '^[a-z]*: [0-9]* passed, [0-9]* failed$' "$log")
-[ "$suites" -eq 2 ] || failed=$((failed + 1)) # a suite that died before its summary
+[ "$suites" -eq 3 ] || failed=$((failed + 1)) # a suite that died before its summary
 [ "$unit_status" -eq 0 ] || [ "$failed" -gt 0 ] || failed=1
 echo "total: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

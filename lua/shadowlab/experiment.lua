@@ -315,6 +315,7 @@ function Experiment:run(argv)
   local configs = self:configurations()
   local writer, header = self:open_results(o, configs)
   local result = { experiment = self, header = header, out = o.out, sharded = o.shard.count > 1, rows = {},
+                   quiet = o.quiet,
                    computed = 0, skipped = 0, failed = 0, dropped = writer.dropped }
   if writer.dropped > 0 and not o.quiet then
     io.stderr:write(string.format("%s: dropped a half-written last row\n", writer.path))

@@ -229,6 +229,7 @@ end
 function report.write(result, opts)
   opts = opts or {}
   if result.sharded then
+    if result.quiet then return nil end
     io.stderr:write("report: this is one shard; merge the shards (shadowlab merge), then run again with --resume\n")
     return nil
   end

@@ -1,0 +1,165 @@
+#!/bin/sh
+# run.sh -- the Lua lab's tests: the helpers' unit tests, the module from a
+# plain lua5.4, exit statuses and bad parameters, a sweep killed with SIGKILL
+# and resumed, the same sweep as 2 shards through GNU Parallel (and the Slurm
+# script) merged and compared with the unsharded run, merge refusals, and the
+# report opened in headless Chromium. Usage: tests/lua/run.sh build/shadowlab.
+# Prints "lua: N passed, N failed".
+set -u
+SL=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
+BUILD=$(dirname "$SL")
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+cd "$ROOT"
+TMP=$(mktemp -d /tmp/shadowlab-lua-XXXXXX)
+trap 'rm -rf "$TMP"' EXIT
+export SHADOWLAB_CACHE="$TMP/cache"
+SWEEP=tests/lua/small-sweep.lua
+pass=0
+fail=0
+
+ok() { pass=$((pass + 1)); echo "ok   $1"; }
+no() { fail=$((fail + 1)); echo "FAIL $1: $2"; [ -f "$TMP/err" ] && sed 's/^/    /' "$TMP/err" | tail -6; }
+
+# expect NAME STATUS WORDS... -- COMMAND...: exit status and words in stdout+stderr
+expect() {
+    name=$1; want=$2; shift 2
+    words=""
+    while [ "$1" != "--" ]; do words="$words|$1"; shift; done
+    shift
+    "$@" >"$TMP/err" 2>&1
+    got=$?
+    if [ "$got" -ne "$want" ]; then no "$name" "exit $got, expected $want"; return 1; fi
+    old_ifs=$IFS; IFS='|'
+    for w in ${words#|}; do
+        if ! grep -qF -- "$w" "$TMP/err"; then IFS=$old_ifs; no "$name" "output lacks '$w'"; return 1; fi
+    done
+    IFS=$old_ifs
+    ok "$name"
+}
+
+# same NAME A B: two results files hold the same configurations and outcomes
+same() {
+    if "$SL" run tests/lua/same-results.lua "$2" "$3" >"$TMP/err" 2>&1; then ok "$1"; else no "$1" "$(head -1 "$TMP/err")"; fi
+}
+
+rows() { echo $(($(wc -l <"$1") - 1)); }
+
+# ---- helpers' unit tests (they print their own ok/FAIL lines)
+mkdir -p "$TMP/unit"
+"$SL" run tests/lua/test_helpers.lua "$TMP/unit" >"$TMP/unit.out" 2>&1
+cat "$TMP/unit.out"
+pass=$((pass + $(grep -c '^ok ' "$TMP/unit.out")))
+fail=$((fail + $(grep -c '^FAIL ' "$TMP/unit.out")))
+grep -qE '^(ok|FAIL) ' "$TMP/unit.out" || no lua_unit_tests "no test ran"
+
+# ---- the module in a plain interpreter
+expect plain_lua_require 0 "hard" "offset_scale" -- env LUA_CPATH="$BUILD/?.so;;" lua5.4 -e \
+    'local sl = require "shadowlab"; local sweep = require "shadowlab.sweep"
+     for _, t in ipairs(sl.techniques()) do print(t.name, t.params[1] and t.params[1].name) end
+     assert(#sweep.grid{a = {1, 2}} == 2)'
+
+# ---- exit statuses and bad input
+expect run_needs_a_script 2 "missing SCRIPT" -- "$SL" run
+expect run_missing_script 1 "cannot open" -- "$SL" run "$TMP/nope.lua"
+expect run_syntax_error 1 "syntax.lua:2:" -- "$SL" run tests/lua/bad/syntax.lua
+expect bad_param_refused_before_running 1 "offset_scale" "[0, 10000]" -- \
+    "$SL" run tests/lua/bad/bad-param.lua --out "$TMP/bad"
+if [ -e "$TMP/bad" ]; then no bad_param_writes_nothing "$TMP/bad exists"; else ok bad_param_writes_nothing; fi
+expect unknown_param_names_the_known_ones 1 "unknown parameter 'ofset_scale'" "offset_scale" -- \
+    "$SL" run tests/lua/bad/unknown-param.lua
+expect experiment_unknown_argument 2 "unknown argument '--frob'" -- "$SL" run "$SWEEP" --frob
+expect experiment_bad_shard 2 "--shard expects I/N" -- "$SL" run "$SWEEP" --shard 2/2
+
+# ---- the unsharded sweep (with images: the browser test opens its report)
+FULL=$TMP/full
+expect sweep_runs_and_reports 0 "6 computed" "report:" -- "$SL" run "$SWEEP" --out "$FULL"
+[ "$(rows "$FULL/records.jsonl")" -eq 6 ] && ok sweep_records_six_rows || no sweep_records_six_rows "$(rows "$FULL/records.jsonl") rows"
+[ "$(wc -l <"$FULL/results.csv")" -eq 7 ] && ok sweep_csv_has_a_line_per_row || no sweep_csv_has_a_line_per_row "csv"
+expect sweep_refuses_to_overwrite 1 "--resume" -- "$SL" run "$SWEEP" --out "$FULL" --quiet
+expect sweep_resume_of_a_finished_run_computes_nothing 0 "0 computed, 6 already recorded" -- \
+    "$SL" run "$SWEEP" --out "$FULL" --resume
+for f in index.html plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg \
+         plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.png plots/error-vs-offset-scale-sphere-on-plane.svg \
+         plots/cost-vs-lights-1-radius-sphere-on-plane.png; do
+    [ -s "$FULL/$f" ] && ok "report_wrote_$(basename "$f")" || no "report_wrote_$(basename "$f")" "missing"
+done
+if grep -q "reference 16 samples, noise rms" "$FULL/plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg" &&
+   grep -q "64x48" "$FULL/plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg"; then
+    ok plot_states_scene_resolution_samples_noise
+else no plot_states_scene_resolution_samples_noise "title"; fi
+
+# ---- killed with SIGKILL mid-way, a torn last row, then --resume
+KILLED=$TMP/killed
+SHADOWLAB_TEST_ROW_DELAY=0.5 "$SL" run "$SWEEP" --out "$KILLED" --quiet >/dev/null 2>&1 &
+pid=$!
+for _ in $(seq 1 300); do
+    [ -f "$KILLED/records.jsonl" ] && [ "$(wc -l <"$KILLED/records.jsonl")" -ge 3 ] && break
+    sleep 0.1
+done
+kill -9 "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+before=$(rows "$KILLED/records.jsonl")
+if [ "$before" -ge 2 ] && [ "$before" -lt 6 ]; then ok "kill9_left_${before}_of_6_rows"; else no kill9_mid_way "$before rows"; fi
+cp "$KILLED/records.jsonl" "$TMP/before.jsonl"
+printf '{"index":5,"key":"0123456789abcdef","status":"o' >>"$KILLED/records.jsonl"
+expect resume_drops_the_torn_row_and_skips_finished_ones 0 "dropped a half-written last row" \
+    "$((6 - before)) computed, $before already recorded" -- "$SL" run "$SWEEP" --out "$KILLED" --resume
+same resume_equals_the_uninterrupted_run "$KILLED/records.jsonl" "$FULL/records.jsonl"
+if head -n $((before + 1)) "$KILLED/records.jsonl" | cmp -s - "$TMP/before.jsonl"; then
+    ok resume_keeps_finished_rows_byte_for_byte
+else no resume_keeps_finished_rows_byte_for_byte "rows changed"; fi
+
+# ---- 2 shards through GNU Parallel (tools/parallel-sweep.sh), merged, reported
+PAR=$TMP/par
+expect parallel_recipe_shards_merges_reports 0 "6 of 6 configurations from 2 files" "0 computed, 6 already recorded" -- \
+    env SHADOWLAB="$SL" tools/parallel-sweep.sh -t 1 -o "$PAR" "$SWEEP" 2
+[ -f "$PAR/shards/0/records.shard-0-of-2.jsonl" ] && [ -f "$PAR/shards/1/records.shard-1-of-2.jsonl" ] &&
+    ok shards_write_their_own_files || no shards_write_their_own_files "missing shard files"
+same sharded_equals_unsharded "$PAR/records.jsonl" "$FULL/records.jsonl"
+[ -s "$PAR/index.html" ] && ok merged_report_written || no merged_report_written "no index.html"
+
+# ---- the Slurm array script, run as its two tasks would be
+SLURM=$TMP/slurm
+for i in 0 1; do
+    SLURM_ARRAY_TASK_ID=$i SLURM_ARRAY_TASK_MIN=0 SLURM_ARRAY_TASK_MAX=1 SLURM_CPUS_PER_TASK=1 \
+        SLURM_SUBMIT_DIR="$ROOT" SHADOWLAB="$SL" bash tools/slurm-sweep.sh "$SWEEP" "$SLURM" >"$TMP/err" 2>&1 ||
+        no "slurm_task_$i" "exit $?"
+done
+expect slurm_shards_merge 0 "6 of 6" -- "$SL" merge -o "$SLURM" "$SLURM"/shards/*
+same slurm_equals_unsharded "$SLURM/records.jsonl" "$FULL/records.jsonl"
+
+# ---- merge refusals
+expect merge_refuses_duplicates 1 "refusing duplicates" -- "$SL" merge -o "$TMP/dup" "$FULL" "$PAR/shards/0"
+"$SL" run "$SWEEP" --out "$TMP/other" --shard 0/2 --samples 8 --quiet --no-images >/dev/null 2>&1
+expect merge_refuses_mismatched_experiments 1 "refusing to merge different experiments" -- \
+    "$SL" merge -o "$TMP/mix" "$TMP/other" "$PAR/shards/1"
+expect merge_refuses_to_overwrite 1 "--force" -- "$SL" merge -o "$PAR" "$PAR/shards/0" "$PAR/shards/1"
+expect resume_refuses_another_experiment 1 "fingerprint" "--fresh" -- \
+    "$SL" run "$SWEEP" --out "$FULL" --resume --samples 8 --quiet
+
+# ---- the report in headless Chromium: every image and plot loads, nothing logged
+browse() { # browse DIR: DOM after load in $TMP/dom.html, browser log in $TMP/browser.log
+    rm -rf "$TMP/profile"
+    timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-background-networking \
+        --disable-component-update --disable-sync --no-first-run --user-data-dir="$TMP/profile" \
+        --enable-logging=stderr --v=0 --virtual-time-budget=10000 --dump-dom "file://$1/index.html" \
+        >"$TMP/dom.html" 2>"$TMP/browser.log"
+}
+if command -v chromium >/dev/null; then
+    images=$(grep -o '<img ' "$FULL/index.html" | wc -l)
+    browse "$FULL"
+    if grep -q "data-images=\"$images\" data-missing=\"0\"" "$TMP/dom.html" && [ "$images" -gt 20 ]; then
+        ok "browser_loads_all_${images}_images_and_plots"
+    else no browser_loads_every_image "$(grep -o 'id="load-status"[^<]*' "$TMP/dom.html")"; fi
+    if grep -q "CONSOLE" "$TMP/browser.log"; then no browser_page_logs_nothing "$(grep CONSOLE "$TMP/browser.log" | head -2)"
+    else ok browser_page_logs_nothing; fi
+    cp -r "$FULL" "$TMP/broken" && rm "$TMP/broken/plots/cost-vs-offset-scale-sphere-on-plane.svg"
+    browse "$TMP/broken"
+    if grep -q 'data-missing="1"' "$TMP/dom.html"; then ok browser_check_sees_a_missing_plot
+    else no browser_check_sees_a_missing_plot "$(grep -o 'id="load-status"[^<]*' "$TMP/dom.html")"; fi
+else
+    no browser_test "chromium is missing (make deps installs it)"
+fi
+
+echo "lua: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]

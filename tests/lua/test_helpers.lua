@@ -1,0 +1,237 @@
+-- test_helpers.lua -- tests of the pure-Lua helpers (json, sweep, pareto,
+-- records, experiment, autotune) and of the module's refusals, run by
+-- `shadowlab run`. Prints "ok NAME" or "FAIL NAME: why" per test; the exit
+-- status is the number of failures (tests/lua/run.sh counts the lines).
+local sl = require "shadowlab"
+local json = require "shadowlab.json"
+local sweep = require "shadowlab.sweep"
+local pareto = require "shadowlab.pareto"
+local records = require "shadowlab.records"
+local experiment = require "shadowlab.experiment"
+local autotune = require "shadowlab.autotune"
+
+local tmp = assert(arg[1], "usage: test_helpers.lua TMPDIR")
+local small = { ["camera.width"] = 40, ["camera.height"] = 30 }
+local tests, failed = {}, 0
+
+local function test(name, fn) tests[#tests + 1] = { name = name, fn = fn } end
+
+local function expect_error(fn, ...)
+  local ok, msg = pcall(fn)
+  if ok then error("expected an error", 2) end
+  msg = tostring(msg)
+  for _, word in ipairs({ ... }) do
+    if not msg:find(word, 1, true) then error(string.format("error lacks '%s': %s", word, msg), 2) end
+  end
+  return msg
+end
+
+local function deep_equal(a, b)
+  if type(a) ~= type(b) then return false end
+  if type(a) ~= "table" then return a == b or (a ~= a and b ~= b) end
+  for k, v in pairs(a) do
+    if not deep_equal(v, b[k]) then return false end
+  end
+  for k in pairs(b) do
+    if a[k] == nil then return false end
+  end
+  return true
+end
+
+---------------------------------------------------------------- json
+
+test("json_round_trips_values_exactly", function()
+  local value = { s = 'quote " backslash \\ tab \t newline \n é ☃ \1', i = -42, big = 1 << 53,
+                  f = { 0.1, 1e-300, 2.5e300, -0.0, 2 ^ 60, 1 / 3, 123456.789 }, t = true, n = false,
+                  empty_array = json.as_array({}), empty_object = {}, nested = { { a = { 1, 2, { b = json.null } } } } }
+  local text = json.encode(value)
+  assert(not text:find("\n"), "one line")
+  local back = json.decode(text)
+  assert(deep_equal(back, value), "decode(encode(v)) == v")
+  assert(json.encode(back) == text, "encode is deterministic")
+  assert(math.type(back.i) == "integer" and math.type(back.f[5]) == "float", "integer and float kept apart")
+  assert(json.encode(json.decode("[]")) == "[]" and json.encode(json.decode("{}")) == "{}")
+  assert(json.decode('"\\ud83d\\ude00"') == "😀", "surrogate pairs")
+end)
+
+test("json_errors_say_where", function()
+  expect_error(function() json.decode('{"a": 1,\n "b": }') end, "line 2")
+  expect_error(function() json.decode('{"a": 1} x') end, "trailing")
+  expect_error(function() json.decode('{"a": "unterminated') end, "unterminated")
+end)
+
+---------------------------------------------------------------- sweep
+
+test("sweep_grid_is_the_cartesian_product", function()
+  local points = sweep.grid{ a = { 1, 2, 3 }, b = { "x", "y" } }
+  assert(#points == 6)
+  local seen = {}
+  for _, p in ipairs(points) do seen[p.a .. p.b] = (seen[p.a .. p.b] or 0) + 1 end
+  for _, a in ipairs({ 1, 2, 3 }) do
+    for _, b in ipairs({ "x", "y" }) do assert(seen[a .. b] == 1, "combination " .. a .. b) end
+  end
+  expect_error(function() sweep.grid{ a = {} } end, "non-empty")
+end)
+
+test("sweep_zip_pairs_elements", function()
+  local points = sweep.zip{ K = { 1, 3, 5 }, map_size = { 256, 512, 1024 } }
+  assert(#points == 3 and points[2].K == 3 and points[2].map_size == 512)
+  expect_error(function() sweep.zip{ K = { 1, 3 }, map_size = { 1 } } end, "map_size")
+end)
+
+test("sweep_latin_has_one_sample_per_stratum", function()
+  local n = 16
+  local points = sweep.latin({ x = { 0, 1 }, k = { 1, 64, "int log" }, r = { 0.01, 1, "log" } }, n, 7)
+  assert(#points == n)
+  local strata_x, strata_r = {}, {}
+  for _, p in ipairs(points) do
+    assert(p.x >= 0 and p.x < 1 and math.type(p.k) == "integer" and p.k >= 1 and p.k <= 64)
+    strata_x[math.floor(p.x * n)] = true
+    strata_r[math.floor((math.log(p.r) - math.log(0.01)) / (math.log(1) - math.log(0.01)) * n)] = true
+  end
+  for s = 0, n - 1 do assert(strata_x[s] and strata_r[s], "stratum " .. s .. " holds a sample") end
+  assert(deep_equal(points, sweep.latin({ x = { 0, 1 }, k = { 1, 64, "int log" }, r = { 0.01, 1, "log" } }, n, 7)),
+         "same seed, same points")
+  assert(not deep_equal(points, sweep.latin({ x = { 0, 1 }, k = { 1, 64, "int log" }, r = { 0.01, 1, "log" } }, n, 8)),
+         "another seed, other points")
+  expect_error(function() sweep.latin({ r = { 0, 1, "log" } }, 4, 1) end, "min > 0")
+end)
+
+test("sweep_random_stays_in_range_and_ranges_come_from_the_registry", function()
+  local hard = sl.technique("hard")
+  local ranges = sweep.ranges_of(hard, { "offset_scale" })
+  assert(ranges.offset_scale[1] == hard.params[1].min and ranges.offset_scale[2] == hard.params[1].max)
+  for _, p in ipairs(sweep.random(ranges, 50, 3)) do
+    assert(p.offset_scale >= hard.params[1].min and p.offset_scale <= hard.params[1].max)
+  end
+  expect_error(function() sweep.ranges_of(hard, { "nope" }) end, "nope")
+end)
+
+---------------------------------------------------------------- pareto
+
+test("pareto_front_matches_brute_force", function()
+  local u = sweep.rng(11)
+  for trial = 1, 20 do
+    local points = {}
+    for i = 1, 40 do points[i] = { x = math.floor(u() * 20), y = math.floor(u() * 20), id = i } end
+    local front = pareto.front(points)
+    local on = {}
+    for _, p in ipairs(front) do on[p.id] = true end
+    for _, p in ipairs(points) do
+      local dominated = false
+      for _, q in ipairs(points) do dominated = dominated or pareto.dominates(q, p) end
+      assert((on[p.id] or false) == not dominated, string.format("trial %d point %d (%g, %g)", trial, p.id, p.x, p.y))
+    end
+    for i = 2, #front do assert(front[i].x >= front[i - 1].x and front[i].y <= front[i - 1].y, "sorted staircase") end
+  end
+end)
+
+---------------------------------------------------------------- records
+
+local function header(fp) return { shadowlab_results = 1, name = "t", fingerprint = fp, settings = {},
+                                   columns = { "index", "key", "status", "rmse" } } end
+
+local function line_count(path)
+  local n = 0
+  for _ in io.lines(path) do n = n + 1 end
+  return n
+end
+
+test("records_drop_a_half_written_last_row_and_keep_the_rest", function()
+  local path, csv = tmp .. "/rec.jsonl", tmp .. "/rec.csv"
+  local w = records.open(path, csv, header("f1"))
+  w:append{ index = 0, key = "a", status = "ok" }
+  w:append{ index = 1, key = "b", status = "ok" }
+  w:close()
+  local f = assert(io.open(path, "ab"))
+  f:write('{"index":2,"key":"c","sta') -- a row cut short, as by kill -9 or power loss
+  f:close()
+  local h, rows, dropped = records.read(path)
+  assert(h.fingerprint == "f1" and #rows == 2 and dropped == 1, "two rows kept, one dropped")
+  w = records.open(path, csv, header("f1"))
+  assert(w.dropped == 1 and w.done.a and w.done.b and not w.done.c)
+  w:append{ index = 2, key = "c", status = "ok" }
+  expect_error(function() w:append{ index = 3, key = "a" } end, "already recorded")
+  w:close()
+  local _, again, dropped2 = records.read(path)
+  assert(#again == 3 and dropped2 == 0 and again[3].key == "c")
+  assert(line_count(csv) == 4, "the CSV has a header and the three rows")
+end)
+
+test("records_refuse_a_corrupt_middle_line_and_another_experiment", function()
+  local path = tmp .. "/bad.jsonl"
+  sl.write_file(path, json.encode(header("f1")) .. '\n{"key":"a"}\n{"key": oops}\n{"key":"b"}\n')
+  expect_error(function() records.read(path) end, path .. ":3:")
+  local good = tmp .. "/good.jsonl"
+  records.open(good, tmp .. "/good.csv", header("f1")):close()
+  expect_error(function() records.open(good, tmp .. "/good.csv", header("f2")) end, "fingerprint f1", "--fresh")
+end)
+
+---------------------------------------------------------------- experiment and module refusals
+
+test("experiment_refuses_bad_parameters_before_running_anything", function()
+  local e = experiment.new{ name = "bad" }
+  expect_error(function() e:add("hard", { { offset_scale = -1 } }) end, "offset_scale", "[0, 10000]")
+  expect_error(function() e:add("hard", { { nope = 1 } }) end, "unknown parameter 'nope'", "offset_scale")
+  expect_error(function() e:add("hard", { { offset_scale = "wide" } }) end, "offset_scale", "wide")
+  expect_error(function() e:add("no-such-technique") end, "unknown technique", "hard")
+  expect_error(function() experiment.new{ name = "x", sampels = 3 } end, "unknown field 'sampels'")
+  expect_error(function() experiment.new{ name = "a b" } end, "name")
+end)
+
+test("module_refuses_bad_options_and_parameters", function()
+  local lab = sl.open("scenes/sphere-on-plane.lua", small)
+  expect_error(function() lab:compare{ technique = "hard", params = { offset_scale = 1e9 } } end, "offset_scale",
+               "[0, 10000]")
+  expect_error(function() lab:render{ technique = "hard", repeats = 0 } end, "repeats", "[1, 10000]")
+  expect_error(function() lab:render{ technique = "hard", light = 2 } end, "light 2", "[1, 1]")
+  expect_error(function() lab:reference{ pattern = "sobol" } end, "sobol")
+  expect_error(function() lab:compare{ params = {} } end, "technique is required")
+  expect_error(function() sl.open("scenes/sphere-on-plane.lua", { ["lights[1].radius"] = -1 }) end,
+               "lights[1].radius")
+  for _, t in ipairs(sl.techniques()) do
+    for _, p in ipairs(t.params) do
+      if p.type == "int" or p.type == "float" then
+        expect_error(function() sl.params(t.name, { [p.name] = p.max + 1 }) end, p.name, p.range)
+      end
+    end
+  end
+  lab:close()
+end)
+
+test("configuration_keys_are_stable_and_depend_on_the_scene_and_every_parameter", function()
+  local a = sl.open("scenes/sphere-on-plane.lua", small)
+  local b = sl.open("scenes/sphere-on-plane.lua", { ["camera.height"] = 30, ["camera.width"] = 40 })
+  local c = sl.open("scenes/sphere-on-plane.lua", { ["camera.width"] = 40, ["camera.height"] = 30,
+                                                   ["lights[1].radius"] = 0.3 })
+  assert(a:key("hard", {}) == b:key("hard", { offset_scale = 1.0 }), "same scene content, same parameters")
+  assert(a:key("hard", {}) ~= c:key("hard", {}), "another light, another key")
+  assert(a:key("hard", { offset_scale = 2 }) ~= a:key("hard", {}), "another value, another key")
+  for _, lab in ipairs({ a, b, c }) do lab:close() end
+end)
+
+test("autotune_returns_the_best_feasible_point_it_evaluated", function()
+  local lab = sl.open("scenes/sphere-on-plane.lua", small)
+  local r = autotune.run{ lab = lab, technique = "hard", budget_s = 1e3, evaluations = 6, initial = 3, samples = 8,
+                          repeats = 1, cache = false }
+  assert(#r.history <= 6 and #r.history >= 4, "evaluations: " .. #r.history)
+  assert(r.feasible and r.best.feasible)
+  for _, p in ipairs(r.history) do
+    assert(p.error >= r.best.error, "no evaluated point beats the best")
+    assert(p.params.offset_scale >= 0 and p.params.offset_scale <= 1e4)
+  end
+  local none = autotune.run{ lab = lab, technique = "hard", budget_s = 0, evaluations = 3, initial = 2, samples = 8,
+                             repeats = 1, cache = false }
+  assert(not none.feasible, "nothing fits a zero budget")
+  for _, p in ipairs(none.history) do assert(p.time >= none.best.time, "infeasible: the fastest is reported") end
+  lab:close()
+end)
+
+for _, t in ipairs(tests) do
+  local ok, err = pcall(t.fn)
+  if ok then print("ok   " .. t.name) else
+    failed = failed + 1
+    print("FAIL " .. t.name .. ": " .. tostring(err))
+  end
+end
+return failed
