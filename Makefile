@@ -4,7 +4,9 @@
 
 CC      ?= cc
 CXX     ?= c++
-OPT     ?= -O2
+# Vectorise loops whenever the cost model says it pays (the -O2 default, "very cheap", skips
+# loops of unknown trip count, which is every span of the rasterizer).
+OPT     ?= -O2 -fvect-cost-model=dynamic
 # snprintf into bounded buffers truncates by design: that warning is off.
 WARN    := -Wall -Wextra -Werror -Wno-format-truncation
 INCS     = -Isrc -I$(B)/gen -I/usr/include/lua5.4 -I/usr/include/OpenEXR

@@ -4,10 +4,10 @@
  *      point, orient counter-clockwise, fan into triangles, count per tile;
  *   3. binning: prefix sums give every tile a list of triangles in input
  *      order (chunks are contiguous, so the order is deterministic);
- *   4. tiles in parallel: 8x8 blocks trivially rejected, trivially accepted
- *      (no edge tests) or tested per texel with exact edge functions.
+ *   4. tiles in parallel: per row, the exact span the three edge functions
+ *      allow (integer arithmetic), then a vectorised depth loop over it.
  * Edge functions are integers below 2^47 (8 sub-texel bits, maps up to
- * 16384^2) held in doubles, which represent them exactly and vectorise. */
+ * 16384^2), evaluated in int64. */
 #include "raster/raster.h"
 #include <omp.h>
 #include <stdlib.h>
@@ -17,8 +17,6 @@
 #define SUB (1 << RASTER_SUBPIXEL_BITS) /* sub-texel steps per texel */
 #define HALF (SUB / 2)                  /* texel centre offset */
 #define TILE 64                          /* texels per tile side */
-#define BLOCK 8                          /* texels per block side */
-#define SMALL_TRIANGLE 64                /* bbox texels below which blocks are not worth it */
 
 /* How the stored value is interpolated over a triangle. */
 typedef enum ValueMode {
@@ -50,6 +48,9 @@ typedef struct Setup {
 } Setup;
 
 static long floor_div(long a, long b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+/* min/max that compile to one instruction (libm's fmin/fmax are calls) */
+static inline double dmin(double a, double b) { return a < b ? a : b; }
+static inline double dmax(double a, double b) { return a > b ? a : b; }
 
 bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids, Error *err)
 {
@@ -78,23 +79,7 @@ void depth_buffer_free(DepthBuffer *db)
 
 /* ---- 1. vertices ---------------------------------------------------------- */
 
-static void transform_vertices(const RasterMesh *m, const RasterView *v, ClipVertex *out)
-{
-    const double *r = v->depth_row;
-#pragma omp parallel for schedule(static)
-    for (int i = 0; i < m->num_vertices; i++) {
-        dvec3 p = d3_from(m->positions[i]);
-        dvec4 c = m4_apply(&v->clip_from_world, p);
-        if (v->mapping == RASTER_PARABOLOID) /* light view space, front = -z: clip z = -z_view >= 0 */
-            out[i] = (ClipVertex){c.x, c.y, -c.z, 1.0, 0.0};
-        else
-            out[i] = (ClipVertex){c.x, c.y, c.z, c.w, r[0] * p.x + r[1] * p.y + r[2] * p.z + r[3]};
-    }
-}
-
-/* ---- 2. triangles ---------------------------------------------------------- */
-
-/* Screen position (texels), value and 1/w of a clipped vertex. */
+/* Screen position (texels), value and 1/w of a clip-space vertex. */
 typedef struct ScreenVertex { double sx, sy, f, q; } ScreenVertex;
 
 static bool to_screen(const Setup *s, const ClipVertex *c, ScreenVertex *out)
@@ -119,6 +104,52 @@ static bool to_screen(const Setup *s, const ClipVertex *c, ScreenVertex *out)
     out->sy = (yn + 1.0) * 0.5 * s->height;
     return isfinite(out->sx) && isfinite(out->sy) && isfinite(out->f);
 }
+
+/* Fixed point, rounded; the map spans [0, size] texels (clipped vertices may
+ * round a hair outside, hence the clamp). */
+static int32_t snap(double texels, int size)
+{
+    double v = dmin(dmax(texels, 0.0), (double)size) * SUB + 0.5;
+    return (int32_t)v; /* v >= 0: truncation rounds */
+}
+
+/* A transformed vertex: clip coordinates, the planes it is outside, and,
+ * when inside all of them, its snapped map position and values (computed
+ * once per vertex, so shared vertices snap identically). */
+#define OUTCODE_INVALID (1u << 6) /* inside, but no finite screen position */
+typedef struct RVertex {
+    ClipVertex c;
+    unsigned outcode;
+    int32_t x, y;
+    double f, q;
+} RVertex;
+
+static void transform_vertices(const Setup *s, const RasterMesh *m, RVertex *out)
+{
+    const RasterView *v = s->view;
+    const double *r = v->depth_row;
+    ClipPlanes planes = v->mapping == RASTER_PARABOLOID ? CLIP_FRONT_ONLY : CLIP_FRUSTUM;
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < m->num_vertices; i++) {
+        dvec3 p = d3_from(m->positions[i]);
+        dvec4 c = m4_apply(&v->clip_from_world, p);
+        RVertex *o = &out[i];
+        if (v->mapping == RASTER_PARABOLOID) /* light view space, front = -z: clip z = -z_view >= 0 */
+            o->c = (ClipVertex){c.x, c.y, -c.z, 1.0, 0.0};
+        else
+            o->c = (ClipVertex){c.x, c.y, c.z, c.w, r[0] * p.x + r[1] * p.y + r[2] * p.z + r[3]};
+        o->outcode = clip_outcode(&o->c, planes);
+        ScreenVertex sv;
+        if (o->outcode) continue;
+        if (!to_screen(s, &o->c, &sv)) { o->outcode = OUTCODE_INVALID; continue; }
+        o->x = snap(sv.sx, s->width);
+        o->y = snap(sv.sy, s->height);
+        o->f = sv.f;
+        o->q = sv.q;
+    }
+}
+
+/* ---- 2. triangles ---------------------------------------------------------- */
 
 static bool push_tri(ThreadTris *tt, const SnapTri *t)
 {
@@ -167,14 +198,10 @@ static int64_t area2(const int32_t *x, const int32_t *y, int a, int b, int c)
     return (int64_t)(x[b] - x[a]) * (y[c] - y[a]) - (int64_t)(x[c] - x[a]) * (y[b] - y[a]);
 }
 
-/* Fan the clipped, snapped polygon into counter-clockwise triangles. */
-static bool emit_polygon(const Setup *s, const ScreenVertex *sv, int n, int32_t id, ThreadTris *tt, bool *culled)
+/* Fan the snapped polygon into counter-clockwise triangles. */
+static bool emit_polygon(const Setup *s, const int32_t *x, const int32_t *y, const double *f, const double *q, int n,
+                         int32_t id, ThreadTris *tt, bool *culled)
 {
-    int32_t x[CLIP_MAX_VERTS], y[CLIP_MAX_VERTS];
-    for (int k = 0; k < n; k++) {
-        x[k] = (int32_t)llround(sv[k].sx * SUB);
-        y[k] = (int32_t)llround(sv[k].sy * SUB);
-    }
     int64_t area = 0;
     for (int k = 1; k + 1 < n; k++) area += area2(x, y, 0, k, k + 1);
     /* Counter-clockwise on the map (y up) is front-facing: the light sees the
@@ -190,8 +217,8 @@ static bool emit_polygon(const Setup *s, const ScreenVertex *sv, int n, int32_t 
         for (int v = 0; v < 3; v++) {
             t.x[v] = x[idx[v]];
             t.y[v] = y[idx[v]];
-            t.f[v] = sv[idx[v]].f;
-            t.q[v] = sv[idx[v]].q;
+            t.f[v] = f[idx[v]];
+            t.q[v] = q[idx[v]];
         }
         t.id = id;
         if (texel_range(s, &t)) {
@@ -202,34 +229,51 @@ static bool emit_polygon(const Setup *s, const ScreenVertex *sv, int n, int32_t 
     return true;
 }
 
-static bool setup_triangle(const Setup *s, const ClipVertex *cv, const uint32_t *ix, int32_t id, ThreadTris *tt)
+/* A triangle that crosses frustum planes: clip, project and snap its polygon. */
+static bool emit_clipped(const Setup *s, const RVertex *v[3], unsigned crossing, int32_t id, ThreadTris *tt,
+                         bool *culled)
 {
-    ClipPlanes planes = s->view->mapping == RASTER_PARABOLOID ? CLIP_FRONT_ONLY : CLIP_FRUSTUM;
-    const ClipVertex tri[3] = {cv[ix[0]], cv[ix[1]], cv[ix[2]]};
-    unsigned o0 = clip_outcode(&tri[0], planes), o1 = clip_outcode(&tri[1], planes), o2 = clip_outcode(&tri[2], planes);
-    if (o0 & o1 & o2) { tt->culled++; return true; } /* entirely outside one plane */
+    const ClipVertex tri[3] = {v[0]->c, v[1]->c, v[2]->c};
     ClipVertex poly[CLIP_MAX_VERTS];
-    int n = 3;
-    if (o0 | o1 | o2) {
-        n = clip_triangle(tri, o0 | o1 | o2, poly);
-        tt->clipped++;
-    } else {
-        memcpy(poly, tri, sizeof tri);
+    int n = clip_triangle(tri, crossing & ~OUTCODE_INVALID, poly);
+    int32_t x[CLIP_MAX_VERTS], y[CLIP_MAX_VERTS];
+    double f[CLIP_MAX_VERTS], q[CLIP_MAX_VERTS];
+    for (int k = 0; k < n; k++) {
+        ScreenVertex sv;
+        if (!to_screen(s, &poly[k], &sv)) { *culled = true; return true; }
+        x[k] = snap(sv.sx, s->width);
+        y[k] = snap(sv.sy, s->height);
+        f[k] = sv.f;
+        q[k] = sv.q;
     }
-    ScreenVertex sv[CLIP_MAX_VERTS];
-    for (int k = 0; k < n; k++)
-        if (!to_screen(s, &poly[k], &sv[k])) { tt->culled++; return true; }
-    bool culled = n < 3;
-    if (!culled && !emit_polygon(s, sv, n, id, tt, &culled)) return false;
-    tt->culled += culled;
-    return true;
+    *culled = n < 3;
+    return *culled || emit_polygon(s, x, y, f, q, n, id, tt, culled);
+}
+
+static bool setup_triangle(const Setup *s, const RVertex *rv, const uint32_t *ix, int32_t id, ThreadTris *tt)
+{
+    const RVertex *v[3] = {&rv[ix[0]], &rv[ix[1]], &rv[ix[2]]};
+    unsigned all = v[0]->outcode & v[1]->outcode & v[2]->outcode, any = v[0]->outcode | v[1]->outcode | v[2]->outcode;
+    bool culled;
+    if (all & ~OUTCODE_INVALID) { tt->culled++; return true; } /* entirely outside one plane */
+    bool ok;
+    if (any) {
+        tt->clipped++;
+        ok = emit_clipped(s, v, any, id, tt, &culled);
+    } else {
+        const int32_t x[3] = {v[0]->x, v[1]->x, v[2]->x}, y[3] = {v[0]->y, v[1]->y, v[2]->y};
+        const double f[3] = {v[0]->f, v[1]->f, v[2]->f}, q[3] = {v[0]->q, v[1]->q, v[2]->q};
+        ok = emit_polygon(s, x, y, f, q, 3, id, tt, &culled);
+    }
+    tt->culled += ok && culled;
+    return ok;
 }
 
 /* ---- 4. tiles -------------------------------------------------------------- */
 
 /* Per-triangle constants of the fill. */
 typedef struct Fill {
-    double a[3], b[3], c[3]; /* E_k(P) = a P.x + b P.y + c >= 0 inside (bias folded into c) */
+    int64_t a[3], b[3], c[3]; /* E_k(P) = a P.x + b P.y + c >= 0 inside (bias folded into c), sub-texel units */
     double fx, fy, f0, qx, qy, q0; /* value and 1/w planes at sub-texel P: f0 + fx (P.x - x0) + ... */
     double x0, y0;
     float fmin, fmax;
@@ -243,9 +287,9 @@ static void fill_setup(const SnapTri *t, const RasterOptions *opt, bool perspect
         int64_t c = -(a * t->x[i] + b * t->y[i]);
         if (opt->conservative) c += (llabs(a) + llabs(b)) * HALF; /* any point of the texel square inside */
         else if (!(a > 0 || (a == 0 && b < 0))) c -= 1;       /* top-left rule: only left and top edges own their texels */
-        F->a[k] = (double)a;
-        F->b[k] = (double)b;
-        F->c[k] = (double)c;
+        F->a[k] = a;
+        F->b[k] = b;
+        F->c[k] = c;
     }
     double dx1 = t->x[1] - t->x[0], dy1 = t->y[1] - t->y[0], dx2 = t->x[2] - t->x[0], dy2 = t->y[2] - t->y[0];
     double inv = 1.0 / (dx1 * dy2 - dx2 * dy1); /* > 0: emit_polygon keeps only positive areas */
@@ -258,12 +302,13 @@ static void fill_setup(const SnapTri *t, const RasterOptions *opt, bool perspect
     F->q0 = t->q[0];
     F->x0 = t->x[0];
     F->y0 = t->y[0];
-    F->fmin = (float)fmin(t->f[0], fmin(t->f[1], t->f[2]));
-    F->fmax = (float)fmax(t->f[0], fmax(t->f[1], t->f[2]));
-    if (perspective) { /* the range of the value a = f / q */
-        F->fmin = (float)fmin(t->f[0] / t->q[0], fmin(t->f[1] / t->q[1], t->f[2] / t->q[2]));
-        F->fmax = (float)fmax(t->f[0] / t->q[0], fmax(t->f[1] / t->q[1], t->f[2] / t->q[2]));
-    }
+    F->fmin = -INFINITY;
+    F->fmax = INFINITY;
+    if (!opt->conservative) return;
+    double v[3];
+    for (int k = 0; k < 3; k++) v[k] = perspective ? t->f[k] / t->q[k] : t->f[k]; /* the value a = f / q */
+    F->fmin = (float)dmin(v[0], dmin(v[1], v[2]));
+    F->fmax = (float)dmax(v[0], dmax(v[1], v[2]));
 }
 
 typedef struct Target {
@@ -274,65 +319,76 @@ typedef struct Target {
     bool farthest, perspective, conservative;
 } Target;
 
-/* Texels [i0, i1] of row j; `test` false when the whole span is known inside. */
-static inline long fill_span(const Fill *F, const Target *T, int32_t id, int j, int i0, int i1, bool test)
+/* Texels of row j inside the triangle, exactly: each edge E(i) = a (i SUB +
+ * HALF) + r >= 0 bounds i from one side (a > 0: below, a < 0: above), in
+ * integer arithmetic, so the span equals the per-texel edge tests. */
+static bool row_span(const Fill *F, int j, int *lo, int *hi)
+{
+    int64_t py = (int64_t)j * SUB + HALF;
+    for (int k = 0; k < 3; k++) {
+        int64_t a = F->a[k], r = F->b[k] * py + F->c[k], num = -r - a * HALF, den = a * SUB;
+        if (a > 0) {
+            int64_t m = -floor_div(-num, den); /* ceil(num / den) */
+            if (m > *lo) *lo = m > INT32_MAX ? INT32_MAX : (int)m;
+        } else if (a < 0) {
+            int64_t m = floor_div(-num, -den); /* floor(num / den), den < 0 */
+            if (m < *hi) *hi = m < INT32_MIN ? INT32_MIN : (int)m;
+        } else if (r < 0) {
+            return false;
+        }
+    }
+    return *lo <= *hi;
+}
+
+/* Value of texel k of a span from the row's start, perspective or affine. */
+static inline float span_value(double f_row, double fs, double q_row, double qs, double k, bool perspective)
+{
+    return perspective ? (float)((f_row + fs * k) / (q_row + qs * k)) : (float)(f_row + fs * k);
+}
+
+/* Texels [i0, i1] of row j, all inside the triangle. The common case
+ * (nearest test, no ids, peeling or clamping) is a branch-free loop the
+ * compiler vectorises. */
+static long fill_span(const Fill *F, const Target *T, int32_t id, int j, int i0, int i1)
 {
     double py = (double)j * SUB + HALF, px0 = (double)i0 * SUB + HALF;
-    double e0 = F->a[0] * px0 + F->b[0] * py + F->c[0];
-    double e1 = F->a[1] * px0 + F->b[1] * py + F->c[1];
-    double e2 = F->a[2] * px0 + F->b[2] * py + F->c[2];
     double f_row = F->f0 + F->fx * (px0 - F->x0) + F->fy * (py - F->y0);
     double q_row = F->q0 + F->qx * (px0 - F->x0) + F->qy * (py - F->y0);
-    double fs = F->fx * SUB, qs = F->qx * SUB, a0 = F->a[0] * SUB, a1 = F->a[1] * SUB, a2 = F->a[2] * SUB;
-    size_t row = (size_t)j * (size_t)T->stride;
+    double fs = F->fx * SUB, qs = F->qx * SUB;
+    size_t row = (size_t)j * (size_t)T->stride + (size_t)i0;
+    float *d = T->depth + row;
+    int n = i1 - i0 + 1;
+    bool persp = T->perspective;
+    if (!T->farthest && !T->id && !T->peel && !T->conservative) {
+        int written = 0;
+#pragma omp simd reduction(+ : written)
+        for (int i = 0; i < n; i++) {
+            float v = span_value(f_row, fs, q_row, qs, i, persp), old = d[i];
+            int pass = v < old;
+            d[i] = pass ? v : old;
+            written += pass;
+        }
+        return written;
+    }
     long written = 0;
-    for (int i = i0; i <= i1; i++) {
-        double k = i - i0;
-        if (test && !(e0 + a0 * k >= 0.0 && e1 + a1 * k >= 0.0 && e2 + a2 * k >= 0.0)) continue;
-        float v = T->perspective ? (float)((f_row + fs * k) / (q_row + qs * k)) : (float)(f_row + fs * k);
-        if (T->conservative) v = fminf(fmaxf(v, F->fmin), F->fmax);
-        size_t at = row + (size_t)i;
-        if (T->peel && !(v > T->peel[at])) continue;
-        if (T->farthest ? !(v > T->depth[at]) : !(v < T->depth[at])) continue;
-        T->depth[at] = v;
-        if (T->id) T->id[at] = id;
+    for (int i = 0; i < n; i++) {
+        float v = span_value(f_row, fs, q_row, qs, i, persp);
+        if (T->conservative) v = v < F->fmin ? F->fmin : v > F->fmax ? F->fmax : v;
+        if (T->peel && !(v > T->peel[row + (size_t)i])) continue;
+        if (T->farthest ? !(v > d[i]) : !(v < d[i])) continue;
+        d[i] = v;
+        if (T->id) T->id[row + (size_t)i] = id;
         written++;
     }
     return written;
 }
 
-/* Edge k's smallest and largest value over the block's texel centres. */
-static void edge_bounds(const Fill *F, int k, double px0, double py0, double span, double *lo, double *hi)
-{
-    double e = F->a[k] * px0 + F->b[k] * py0 + F->c[k];
-    double ax = F->a[k] * span, by = F->b[k] * span;
-    *lo = e + fmin(ax, 0.0) + fmin(by, 0.0);
-    *hi = e + fmax(ax, 0.0) + fmax(by, 0.0);
-}
-
 static long fill_rect(const Fill *F, const Target *T, int32_t id, int i0, int j0, int i1, int j1)
 {
     long written = 0;
-    if ((long)(i1 - i0 + 1) * (j1 - j0 + 1) <= SMALL_TRIANGLE) {
-        for (int j = j0; j <= j1; j++) written += fill_span(F, T, id, j, i0, i1, true);
-        return written;
-    }
-    for (int bj = j0; bj <= j1; bj += BLOCK) {
-        int bj1 = bj + BLOCK - 1 < j1 ? bj + BLOCK - 1 : j1;
-        for (int bi = i0; bi <= i1; bi += BLOCK) {
-            int bi1 = bi + BLOCK - 1 < i1 ? bi + BLOCK - 1 : i1;
-            double px0 = (double)bi * SUB + HALF, py0 = (double)bj * SUB + HALF;
-            double span = (double)(BLOCK - 1) * SUB;
-            bool inside = true, outside = false;
-            for (int k = 0; k < 3; k++) {
-                double lo, hi;
-                edge_bounds(F, k, px0, py0, span, &lo, &hi);
-                inside = inside && lo >= 0.0;
-                outside = outside || hi < 0.0;
-            }
-            if (outside) continue;
-            for (int j = bj; j <= bj1; j++) written += fill_span(F, T, id, j, bi, bi1, !inside);
-        }
+    for (int j = j0; j <= j1; j++) {
+        int lo = i0, hi = i1;
+        if (row_span(F, j, &lo, &hi)) written += fill_span(F, T, id, j, lo, hi);
     }
     return written;
 }
@@ -345,7 +401,7 @@ static void quantise(float *d, size_t n, int bits, double lo, double hi)
     if (!(range > 0.0)) return;
     for (size_t i = 0; i < n; i++) {
         if (!isfinite(d[i])) continue;
-        double t = fmin(fmax((d[i] - lo) / range, 0.0), 1.0);
+        double t = dmin(dmax((d[i] - lo) / range, 0.0), 1.0);
         d[i] = (float)(lo + round(t * levels) / levels * range);
     }
 }
@@ -360,11 +416,14 @@ static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, cons
     Target T = {db->depth, db->triangle, opt->peel, s->width, opt->test == RASTER_FARTHEST,
                 s->mode == VALUE_PERSPECTIVE && opt->depth == RASTER_DEPTH_LINEAR, opt->conservative};
     float empty = T.farthest ? -INFINITY : INFINITY;
-    for (int j = tj0; j <= tj1; j++)
-        for (int i = ti0; i <= ti1; i++) {
-            db->depth[(size_t)j * s->width + i] = empty;
-            if (db->triangle) db->triangle[(size_t)j * s->width + i] = -1;
-        }
+    int n = ti1 - ti0 + 1;
+    for (int j = tj0; j <= tj1; j++) {
+        float *d = db->depth + (size_t)j * s->width + ti0;
+        for (int i = 0; i < n; i++) d[i] = empty;
+        if (!db->triangle) continue;
+        int32_t *id = db->triangle + (size_t)j * s->width + ti0;
+        for (int i = 0; i < n; i++) id[i] = -1;
+    }
     long written = 0;
     for (int b = bin_start[tile]; b < bin_start[tile + 1]; b++) {
         const SnapTri *t = bins[b];
@@ -394,7 +453,7 @@ static ValueMode value_mode(const RasterView *v, const RasterOptions *opt)
 }
 
 /* Pass 2 over this thread's chunk of the triangles of every mesh. */
-static bool setup_chunk(const Setup *s, const RasterMesh *meshes, int num_meshes, ClipVertex *const *cv, long t0,
+static bool setup_chunk(const Setup *s, const RasterMesh *meshes, int num_meshes, RVertex *const *cv, long t0,
                         long t1, ThreadTris *tt)
 {
     long base = 0;
@@ -474,14 +533,14 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
                (db->height + TILE - 1) / TILE};
     int nthreads = omp_get_max_threads();
     long total = 0;
-    ClipVertex **cv = calloc((size_t)(num_meshes > 0 ? num_meshes : 1), sizeof *cv);
+    RVertex **cv = calloc((size_t)(num_meshes > 0 ? num_meshes : 1), sizeof *cv);
     ThreadTris *tt = calloc((size_t)nthreads, sizeof *tt);
     bool ok = cv && tt;
     for (int m = 0; ok && m < num_meshes; m++) {
         total += meshes[m].num_triangles;
         cv[m] = malloc(sizeof **cv * (size_t)(meshes[m].num_vertices > 0 ? meshes[m].num_vertices : 1));
         ok = cv[m] != NULL;
-        if (ok) transform_vertices(&meshes[m], view, cv[m]);
+        if (ok) transform_vertices(&s, &meshes[m], cv[m]);
     }
     for (int k = 0; ok && k < nthreads; k++) ok = (tt[k].tile_count = calloc((size_t)s.tiles_x * s.tiles_y, sizeof(int))) != NULL;
     if (ok) {
