@@ -74,6 +74,7 @@ static bool pcf_prepare(const TechContext *ctx, void **state, Error *err)
     }
     st->bias = smap_bias(p, ctx->scene);
     st->K = (int)p[P_K];
+    st->bias.filter_radius = 0.5 * (st->K - 1);
     st->kernel = (int)p[P_KERNEL];
     st->samples = (int)p[P_SAMPLES];
     st->initial = (int)p[P_INITIAL] < st->samples ? (int)p[P_INITIAL] : st->samples;

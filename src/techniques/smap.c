@@ -22,7 +22,7 @@ ShadowMapSpec smap_spec(const double *p)
 SmapBias smap_bias(const double *p, const Scene *scene)
 {
     return (SmapBias){p[SMAP_P_BIAS], p[SMAP_P_BIAS_STEPS], p[SMAP_P_SLOPE_BIAS], p[SMAP_P_SLOPE_MAX],
-                      p[SMAP_P_NORMAL_OFFSET], p[SMAP_P_RECEIVER_PLANE] != 0.0, scene_extent(scene)};
+                      p[SMAP_P_NORMAL_OFFSET], p[SMAP_P_RECEIVER_PLANE] != 0.0, scene_extent(scene), 0.0};
 }
 
 /* World size of one step of the stored depth at the receiver (the r of
@@ -102,9 +102,12 @@ bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_g
     bool plane = (b->receiver_plane || b->slope > 0.0) && receiver_plane(m, r, p, n);
     /* Slope-scaled bias (course §2.1.2: faces aligned with the light's rays
      * need much more): factor x depth slope, clamped, since the slope
-     * diverges at grazing light (where the plane is lost, the clamp). */
-    double slope_max = b->slope_max_texels * r->texel_world * to_stored;
-    double slope = plane ? fmin(b->slope * depth_slope(r), slope_max) : b->slope > 0.0 ? slope_max : 0.0;
+     * diverges at grazing light (where the plane is lost, the clamp). A
+     * filter compares taps up to `filter_radius` texels away, so the depth
+     * it must tolerate grows with it (catalogue ch.4: ~K texel tan(theta)). */
+    double reach = 1.0 + b->filter_radius;
+    double slope_max = b->slope_max_texels * r->texel_world * to_stored * reach;
+    double slope = plane ? fmin(b->slope * depth_slope(r) * reach, slope_max) : b->slope > 0.0 ? slope_max : 0.0;
     double constant = (b->constant_world + b->steps * depth_step_world(m, &r->mc, ndc_per_world)) * to_stored;
     r->bias = constant + slope;
     r->ref = stored_depth(m, &r->mc) - r->bias;

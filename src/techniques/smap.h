@@ -35,19 +35,25 @@ extern const char *const smap_bits_names[];
      "depth storage: f32, or u24/u16 quantised over the light's depth range (course §2.1.2 on precision)",         \
      smap_bits_names}
 
-#define SMAP_BIAS_PARAMS                                                                                           \
+#define SMAP_BIAS_PARAMS SMAP_BIAS_PARAMS_PLANE(0)
+/* The same with the receiver-plane bias on (1) or off (0) by default: wide
+ * kernels (blocker searches, soft-shadow filters) need it on, or every planar
+ * receiver tilted to the light shadows itself (course §5.2.2.1, its third issue). */
+#define SMAP_BIAS_PARAMS_PLANE(receiver_plane_default)                                                             \
     {"bias", PARAM_FLOAT, 0, 0, 1e6, "world units", "constant depth bias along the light's depth axis", NULL},      \
     {"bias_steps", PARAM_FLOAT, 0, 0, 1e9, "depth steps",                                                            \
      "constant bias in steps of the stored depth format at the receiver (glPolygonOffset's units)", NULL},          \
     {"slope_bias", PARAM_FLOAT, 1, 0, 1000, "x depth slope",                                                         \
      "slope-scaled bias (glPolygonOffset's factor): this times the receiver's depth change across one texel, "     \
-     "texel width x tan(angle to the light)",                                                                      \
+     "texel width x tan(angle to the light); filters multiply it by 1 + their radius in texels",                  \
      NULL},                                                                                                        \
     {"slope_max", PARAM_FLOAT, 8, 0, 1e6, "texels",                                                                  \
-     "clamp of the slope-scaled bias in texel widths at the receiver (tan diverges at grazing light)", NULL},      \
+     "clamp of the slope-scaled bias in texel widths at the receiver (tan diverges at grazing light), also "       \
+     "times 1 + a filter's radius",                                                                                \
+     NULL},                                                                                                        \
     {"normal_offset", PARAM_FLOAT, 0, 0, 100, "texels",                                                              \
      "normal-offset bias: the lookup point moves along the geometric normal by this many texel widths", NULL},     \
-    {"receiver_plane", PARAM_BOOL, 0, 0, 1, "",                                                                      \
+    {"receiver_plane", PARAM_BOOL, receiver_plane_default, 0, 1, "",                                                                      \
      "receiver-plane depth bias (Schueler 2006, course §4.1.2 box): each texel is compared with the receiver's "   \
      "plane at that texel's centre, not with the sample's own depth",                                              \
      NULL}
@@ -64,7 +70,8 @@ ShadowMapSpec smap_spec(const double *params);
 typedef struct SmapBias {
     double constant_world, steps, slope, slope_max_texels, normal_offset_texels;
     bool receiver_plane;
-    float scene_extent; /* for the engine's own offset, rt_ray_offset */
+    float scene_extent;   /* for the engine's own offset, rt_ray_offset */
+    double filter_radius; /* texels from the sample to a filter's farthest tap (0: one texel) */
 } SmapBias;
 SmapBias smap_bias(const double *params, const Scene *scene);
 
@@ -102,6 +109,21 @@ static inline double smap_ref_at(const SmapReceiver *r, int i, int j)
 static inline float smap_lit(const ShadowMap *m, const SmapReceiver *r, int i, int j)
 {
     return smap_ref_at(r, i, j) > shadowmap_texel(m, r->mc.face, i, j) ? 0.0f : 1.0f;
+}
+
+/* A stored depth of a face as linear depth (world units along the face's
+ * axis), for techniques whose formulas need distances (blocker depths, shadow
+ * depths): the inverse of z_ndc = f/(f-n) (1 - n/d) for perspective faces and
+ * of z_ndc = (d - n)/(f - n) for orthographic ones; +INFINITY (no caster)
+ * stays infinite. */
+static inline double smap_linear_depth(const ShadowMap *m, int face, double stored)
+{
+    const MapFace *f = &m->view.face[face];
+    if (m->spec.depth == RASTER_DEPTH_LINEAR || !isfinite(stored)) return stored;
+    double n = f->raster.depth_near, far = f->raster.depth_far;
+    if (!f->perspective) return n + stored * (far - n);
+    double den = 1.0 - stored * (far - n) / far; /* n/d: reaches 0 only beyond the far plane */
+    return den > 0.0 ? n / den : INFINITY;
 }
 
 /* Texel of the nearest-sample lookup. */

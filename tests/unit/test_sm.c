@@ -170,3 +170,121 @@ TEST(test_pcf_kernel_sweep_builds_one_depth_map)
     CHECK(built == 1 && reused == 7);
     lab_close(lab);
 }
+
+/* A point light in the middle of a closed room (2 triangles per wall) with
+ * blockers on every side, so every cube face and seam is used, and a wide
+ * plate under the light, made of 2 triangles or of a 32 x 32 grid: the
+ * paraboloid maps vertices only, so the plate's straight edges should
+ * become curves in the map (course §2.1.1: the scene must be finely
+ * tessellated). */
+static const char *room_scene(bool fine_plate)
+{
+    static char text[2048];
+    snprintf(text, sizeof text,
+             "local objs = { { shape = 'box', size = {8, 5, 8}, translate = {0, 2.5, 0} },\n"
+             "  { shape = %s, size = {2.4, 2.4}, rotate = {0, 30, 0}, translate = {0.3, 1.6, 0.2} } }\n"
+             "local spots = { {2, 1, 0}, {-2, 3, 1}, {0, 1.2, 2.2}, {1, 4, -2}, {-1.5, 1, -2}, {2.2, 2.5, 2.2} }\n"
+             "for i, p in ipairs(spots) do objs[#objs + 1] = { shape = 'box', size = {0.5, 0.5, 0.5},\n"
+             "  rotate = {20 * i, 35 * i, 0}, translate = p } end\n"
+             "return { camera = { position = {3.5, 4.2, 3.5}, target = {-1, 0.5, -1}, fov = 80, width = 240, "
+             "height = 180 },\n"
+             "  lights = { { type = 'point', position = {0, 2.5, 0} } }, objects = objs }\n",
+             fine_plate ? "'heightfield', resolution = {32, 32}, elevation = function(x, z) return 0 end" : "'plane'");
+    return text;
+}
+
+static double misclassified(Lab *lab, const RenderResult *truth, const char *tech, const char *const *p, int n)
+{
+    RenderResult r;
+    if (!render(lab, tech, p, n, &r)) return NAN;
+    Disagree d = disagree(lab, &r.visibility, &truth->visibility);
+    render_result_free(&r);
+    return (double)(d.false_shadow + d.false_lit) / (double)d.candidates;
+}
+
+TEST(test_sm_omnidirectional_cube_and_paraboloid_against_hard)
+{
+    const char *pc[] = {"projection=cube", "map_size=512"}, *pp[] = {"projection=paraboloid", "map_size=512"};
+    const char *pk[] = {"projection=cube", "map_size=512", "K=7"};
+    double cube[2], para[2], pcf[2];
+    for (int fine = 0; fine < 2; fine++) {
+        Lab *lab = fixture_lab("room.lua", room_scene(fine));
+        CHECK(lab);
+        RenderResult hard;
+        CHECK(render(lab, "hard", NULL, 0, &hard));
+        cube[fine] = misclassified(lab, &hard, "sm", pc, 2);
+        para[fine] = misclassified(lab, &hard, "sm", pp, 2);
+        pcf[fine] = misclassified(lab, &hard, "pcf", pk, 3);
+        printf("    %s plate: misclassified: cube %.3f%%, paraboloid %.3f%%, pcf K=7 across cube seams %.3f%%\n",
+               fine ? "32x32-grid" : "2-triangle", 100 * cube[fine], 100 * para[fine], 100 * pcf[fine]);
+        render_result_free(&hard);
+        lab_close(lab);
+    }
+    for (int fine = 0; fine < 2; fine++) {
+        CHECK_MSG(cube[fine] < 0.01, "cube map misclassifies %.3f%%", 100 * cube[fine]);
+        CHECK_MSG(pcf[fine] < 0.02, "pcf across cube seams misclassifies %.3f%%", 100 * pcf[fine]);
+    }
+    CHECK_MSG(para[0] > 3 * para[1] && para[0] > 3 * cube[0],
+              "the paraboloid map of a 2-triangle plate should err where the tessellated one does not");
+}
+
+TEST(test_sm_fitting_to_the_visible_receivers_beats_the_scene_bounds)
+{
+    /* a camera close to the ground of a large scene under a directional sun */
+    const char *ov[] = {"camera.width=240", "camera.height=180"};
+    Error err;
+    Lab *lab = lab_open(SCENES "terrain.lua", ov, 2, &err);
+    CHECK_MSG(lab, "%s", err.msg);
+    RenderResult hard, scene, view;
+    const char *ps[] = {"fit=scene", "map_size=1024"}, *pv[] = {"fit=view", "map_size=1024"};
+    CHECK(render(lab, "hard", NULL, 0, &hard) && render(lab, "sm", ps, 2, &scene) && render(lab, "sm", pv, 2, &view));
+    Disagree a = disagree(lab, &scene.visibility, &hard.visibility), b = disagree(lab, &view.visibility, &hard.visibility);
+    printf("    terrain, 1024^2 map: fit scene %ld, fit view %ld misclassified of %ld\n", a.false_shadow + a.false_lit,
+           b.false_shadow + b.false_lit, a.candidates);
+    CHECK(b.false_shadow + b.false_lit < a.false_shadow + a.false_lit);
+    render_result_free(&hard);
+    render_result_free(&scene);
+    render_result_free(&view);
+    lab_close(lab);
+}
+
+/* PCF against the Embree reference (course §4.1.2): for a tiny light it
+ * anti-aliases the hard edge and stays close to the truth; for a large
+ * light its fixed kernel makes the umbra too large and the penumbra too
+ * small (Fig. 4.3), and the error in the penumbra grows. */
+static double pcf_penumbra_rmse(Lab *lab, const char *K, double *all_rmse)
+{
+    Error err;
+    RenderResult r;
+    const char *p[] = {K, "map_size=1024"};
+    RefInfo info;
+    RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1}, NULL};
+    const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    Metrics m;
+    if (!ref || !cls || !render(lab, "pcf", p, 2, &r)) return NAN;
+    bool ok = metrics_compute(&r.visibility, ref, cls, &m, NULL, &err);
+    render_result_free(&r);
+    *all_rmse = ok ? m.region[REGION_ALL].rmse : NAN;
+    return ok ? m.region[REGION_PENUMBRA].rmse : NAN;
+}
+
+TEST(test_pcf_against_the_reference_small_and_large_light)
+{
+    const char *small_ov[] = {"lights[1].radius=0.02", "camera.width=240", "camera.height=180"};
+    const char *large_ov[] = {"lights[1].radius=0.8", "camera.width=240", "camera.height=180"};
+    Error err;
+    Lab *small = lab_open(SCENES "sphere-on-plane.lua", small_ov, 3, &err);
+    Lab *large = lab_open(SCENES "sphere-on-plane.lua", large_ov, 3, &err);
+    CHECK(small && large);
+    double all_small, all_large;
+    double pen_small = pcf_penumbra_rmse(small, "K=3", &all_small), pen_large = pcf_penumbra_rmse(large, "K=3", &all_large);
+    printf("    K=3: light radius 0.02: RMSE %.4f (penumbra %.4f); radius 0.8: RMSE %.4f (penumbra %.4f)\n", all_small,
+           pen_small, all_large, pen_large);
+    /* Bound for the small light: a 3-texel kernel blurs the hard edge over
+     * ~1 screen pixel, so only edge pixels err; RMSE over all pixels < 0.05. */
+    CHECK(all_small < 0.05);
+    CHECK_MSG(pen_large > 0.15 && all_large > 2 * all_small, "a fixed 3-texel kernel cannot follow a wide penumbra");
+    lab_close(small);
+    lab_close(large);
+}
