@@ -135,8 +135,16 @@ bool lab_render_warm(Lab *lab, const RenderRequest *req, int warmup, RenderResul
     out->view_s = timer_now_s() - t0;
     int ref_channels = reference_channels(sc, req->light_index, MEASURE_VISIBILITY);
     TechContext ctx = {sc, req->light_index, &sc->lights[req->light_index], vs, cls, lab->rm, req->params,
-                       req->tech->rgb ? ref_channels : 1};
+                       req->tech->rgb ? ref_channels : 1, NULL};
     if (!image_init(&out->visibility, vs->width, vs->height, ref_channels, err)) return false;
+    int num_aux = tech_aux_count(req->tech);
+    if (num_aux > 0) {
+        if (!image_init(&out->aux, vs->width, vs->height, num_aux, err)) {
+            image_free(&out->visibility);
+            return false;
+        }
+        ctx.aux = out->aux.data;
+    }
     void *state = NULL;
     rm_scope_begin(lab->rm);
     t0 = timer_now_s();
@@ -144,7 +152,7 @@ bool lab_render_warm(Lab *lab, const RenderRequest *req, int warmup, RenderResul
     out->prepare_s = timer_now_s() - t0;
     rm_scope_end(lab->rm);
     if (!prepared) {
-        image_free(&out->visibility);
+        render_result_free(out);
         return error_prefix(err, "%s: ", req->tech->name);
     }
     double built_s;
@@ -155,11 +163,15 @@ bool lab_render_warm(Lab *lab, const RenderRequest *req, int warmup, RenderResul
     out->frame_s = out->tech_build_s + fmax(0.0, out->prepare_s - built_s) + out->eval_median_s;
     if (req->tech->release) req->tech->release(state);
     if (!ok) {
-        image_free(&out->visibility);
+        render_result_free(out);
         return error_set(err, "out of memory");
     }
     finish_image(&out->visibility, ctx.channels, cls);
     return true;
 }
 
-void render_result_free(RenderResult *r) { image_free(&r->visibility); }
+void render_result_free(RenderResult *r)
+{
+    image_free(&r->visibility);
+    image_free(&r->aux);
+}

@@ -30,6 +30,7 @@ typedef struct RenderRequest {
 
 typedef struct RenderResult {
     Image visibility;      /* per view sample, 1 or 3 channels */
+    Image aux;             /* the technique's auxiliary channels (Technique.aux); empty when none */
     double view_s;         /* view samples + classes (0 when reused) */
     double prepare_s;      /* the technique's resource acquisition and set-up */
     double eval_median_s, eval_min_s;

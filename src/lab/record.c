@@ -139,6 +139,42 @@ static void write_metrics(JsonWriter *w, const RunReport *r)
     json_object_end(w);
 }
 
+#define AUX_BINS 16
+
+/* The technique's auxiliary channels over the lit candidates: mean, range,
+ * and how many samples have each integer part 0 .. AUX_BINS - 1 (clamped). */
+static void write_aux(JsonWriter *w, const RunReport *r)
+{
+    Error err;
+    const Image *aux = &r->render->aux;
+    const uint8_t *cls = res_classes(lab_resources(r->lab), lab_scene(r->lab), r->light_index, &err);
+    if (!cls) return; /* the render made them: always held */
+    json_object_begin(w, "aux");
+    for (int k = 0; k < aux->channels; k++) {
+        long counts[AUX_BINS] = {0}, n = 0;
+        double sum = 0, lo = INFINITY, hi = -INFINITY;
+        for (long s = 0; s < (long)aux->width * aux->height; s++) {
+            if (cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+            double v = aux->data[(size_t)s * aux->channels + k];
+            counts[v < 1.0 ? 0 : v >= AUX_BINS - 1 ? AUX_BINS - 1 : (int)v]++;
+            sum += v;
+            lo = fmin(lo, v);
+            hi = fmax(hi, v);
+            n++;
+        }
+        json_object_begin(w, r->tech->aux[k]);
+        json_int(w, "lit_candidates", n);
+        json_number(w, "mean", n ? sum / n : 0.0);
+        json_number(w, "min", n ? lo : 0.0);
+        json_number(w, "max", n ? hi : 0.0);
+        json_array_begin(w, "counts");
+        for (int b = 0; b < AUX_BINS; b++) json_int(w, NULL, counts[b]);
+        json_array_end(w);
+        json_object_end(w);
+    }
+    json_object_end(w);
+}
+
 static void write_timings(JsonWriter *w, const RunReport *r)
 {
     json_object_begin(w, "timings_s");
@@ -213,6 +249,7 @@ void report_write_record_fp(const RunReport *r, FILE *fp)
     if (r->tech) write_technique(&w, r);
     if (r->ref) write_reference(&w, r);
     if (r->metrics) write_metrics(&w, r);
+    if (r->render && r->render->aux.data) write_aux(&w, r);
     write_timings(&w, r);
     write_resources(&w, r);
     write_machine(&w, r->threads);

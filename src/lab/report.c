@@ -105,6 +105,12 @@ bool report_write_exr(const RunReport *r, const char *path, Error *err)
     add_channel(&cl, "depth", vs->depth_view, 1);
     add_channel(&cl, "class", class_img.data, 1);
     add_channel(&cl, "object", object_img.data, 1);
+    const Image *aux = r->render ? &r->render->aux : NULL;
+    for (int k = 0; aux && k < aux->channels && cl.n < MAX_EXR_CHANNELS; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "aux.%s", r->tech->aux[k]);
+        add_channel(&cl, name, aux->data + k, aux->channels);
+    }
 
     char hash[17], params[1024] = "", refdesc[256] = "", light[64], scale[32];
     hash_hex(sc->hash, hash);
@@ -124,7 +130,8 @@ bool report_write_exr(const RunReport *r, const char *path, Error *err)
         {"shadowlab.channels",
          "V or R,G,B: visibility in [0,1] (irradiance: radiance); ref.*: reference; stderr.*: its standard error; "
          "error.*: estimate - reference; P, N: world position and geometric normal; depth: view-axis distance; "
-         "class: 0 background, 1 lit candidate, 2 back-facing, 3 outside light, 4 not a receiver; object: index"},
+         "class: 0 background, 1 lit candidate, 2 back-facing, 3 outside light, 4 not a receiver; object: index; "
+         "aux.*: the technique's auxiliary channels (0 outside the lit candidates)"},
     };
     bool ok = exr_write(path, vs->width, vs->height, cl.ch, cl.n, attrs, (int)(sizeof attrs / sizeof attrs[0]), err);
     image_free(&class_img);
@@ -201,6 +208,21 @@ static void error_colors(const Image *err_img, const uint8_t *cls, double scale,
     }
 }
 
+/* An auxiliary channel's integer values as colours (0 grey, 1 red, 2 green,
+ * 3 blue, 4 and above yellow, as seed 001's Fig. 2 colours its subdivision
+ * levels); samples outside the evaluated class are black. */
+static void aux_colors(const Image *aux, int k, const uint8_t *cls, Image *out)
+{
+    static const float palette[5][3] = {{0.35f, 0.35f, 0.35f}, {0.9f, 0.1f, 0.1f}, {0.1f, 0.8f, 0.1f},
+                                        {0.15f, 0.3f, 1.0f}, {1.0f, 0.9f, 0.1f}};
+    for (int s = 0; s < out->width * out->height; s++) {
+        float *o = out->data + 3 * (size_t)s;
+        float v = aux->data[(size_t)s * aux->channels + k];
+        int level = v >= 4.0f ? 4 : v >= 0.0f ? (int)v : 0;
+        for (int c = 0; c < 3; c++) o[c] = cls[s] == SAMPLE_LIT_CANDIDATE ? palette[level][c] : 0.0f;
+    }
+}
+
 bool report_write_previews(const RunReport *r, const char *dir, Error *err)
 {
     const Scene *sc = lab_scene(r->lab);
@@ -220,18 +242,29 @@ bool report_write_previews(const RunReport *r, const char *dir, Error *err)
         error_colors(r->signed_error, cls, r->error_scale, &rgb);
         ok = write_png(dir, stem, "-error", &rgb, ss, false, err);
     }
+    const Image *aux = r->render ? &r->render->aux : NULL;
+    for (int k = 0; ok && aux && k < aux->channels; k++) {
+        char suffix[48];
+        snprintf(suffix, sizeof suffix, "-aux-%s", r->tech->aux[k]);
+        aux_colors(aux, k, cls, &rgb);
+        ok = write_png(dir, stem, suffix, &rgb, ss, false, err);
+    }
     image_free(&rgb);
     return ok;
 }
 
 /* ---- all outputs, atomically per run ------------------------------------ */
 
-static void remove_outputs(const char *dir, const char *stem)
+static void remove_outputs(const RunReport *r, const char *dir, const char *stem)
 {
     static const char *const suffixes[] = {".exr", ".json", ".png", "-shaded.png", "-error.png"};
     char path[4096];
     for (size_t i = 0; i < sizeof suffixes / sizeof suffixes[0]; i++) {
         snprintf(path, sizeof path, "%s/%s%s", dir, stem, suffixes[i]);
+        remove(path);
+    }
+    for (int k = 0; r->tech && k < tech_aux_count(r->tech); k++) {
+        snprintf(path, sizeof path, "%s/%s-aux-%s.png", dir, stem, r->tech->aux[k]);
         remove(path);
     }
 }
@@ -247,6 +280,6 @@ bool report_write_all(RunReport *r, const char *dir, bool png, Error *err)
     r->output_s = timer_now_s() - t0;
     snprintf(path, sizeof path, "%s/%s.json", dir, stem);
     ok = ok && report_write_record(r, path, err);
-    if (!ok) remove_outputs(dir, stem);
+    if (!ok) remove_outputs(r, dir, stem);
     return ok;
 }

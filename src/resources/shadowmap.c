@@ -68,7 +68,8 @@ static RasterOptions raster_options(const ShadowMapSpec *spec, const float *peel
     RasterOptions o = {.cull = spec->cull, .test = RASTER_NEAREST, .depth = spec->depth,
                        .depth_bits = spec->depth_bits, .conservative = spec->conservative,
                        .triangle_ids = spec->triangle_ids, .peel = peel};
-    if (spec->layer == MAP_LAYER_BACKFACES) o.cull = RASTER_CULL_FRONT;
+    if (spec->layer == MAP_LAYER_BACKFACES || spec->layer == MAP_LAYER_FARTHEST_BACKFACES) o.cull = RASTER_CULL_FRONT;
+    if (spec->layer == MAP_LAYER_FARTHEST_BACKFACES) o.test = RASTER_FARTHEST;
     if (spec->layer == MAP_LAYER_PEELED) o.cull = RASTER_CULL_NONE;
     return o;
 }
@@ -96,6 +97,8 @@ static bool render_faces(ShadowMap *m, const MapArgs *a, const ShadowMap *under,
         RasterOptions opt = raster_options(&a->spec, under ? under->depth + f * face_texels : NULL);
         RasterStats st;
         ok = raster_depth(meshes, nm, &m->view.face[f].raster, &opt, &db, &st, err);
+        for (size_t i = 0; opt.test == RASTER_FARTHEST && i < face_texels; i++) /* the map's empty: +INFINITY */
+            if (db.depth[i] == -INFINITY) db.depth[i] = INFINITY;
         m->stats.triangles_in += st.triangles_in;
         m->stats.triangles_culled += st.triangles_culled;
         m->stats.triangles_clipped += st.triangles_clipped;
@@ -161,7 +164,7 @@ static uint64_t map_key(const Scene *sc, int light_index, const ShadowMapSpec *s
 
 static const char *layer_name(MapLayer l)
 {
-    static const char *const names[] = {"first layer", "back faces", "peeled second layer"};
+    static const char *const names[] = {"first layer", "back faces", "peeled second layer", "farthest back faces"};
     return names[l];
 }
 

@@ -18,6 +18,7 @@ typedef enum MapLayer {
     MAP_LAYER_FIRST,     /* the nearest surface (back faces included unless culled) */
     MAP_LAYER_BACKFACES, /* the nearest back face: the second layer of closed meshes (Wang & Molnar) */
     MAP_LAYER_PEELED,    /* the nearest surface strictly behind the first layer: any mesh */
+    MAP_LAYER_FARTHEST_BACKFACES, /* the farthest back face (a 'z-greater' test, seed 003 §5) */
 } MapLayer;
 
 typedef struct ShadowMapSpec {

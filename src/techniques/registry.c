@@ -8,11 +8,15 @@
 extern const Technique tech_hard;
 extern const Technique tech_sm;
 extern const Technique tech_pcf;
+extern const Technique tech_adaptive_area;
+extern const Technique tech_shadow_width;
 
 static const Technique *const registry[] = {
     &tech_hard,
     &tech_sm,
     &tech_pcf,
+    &tech_adaptive_area,
+    &tech_shadow_width,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }

@@ -41,6 +41,9 @@ typedef struct TechContext {
     ResourceManager *rm;
     const double *params;        /* values in declaration order */
     int channels;                /* 1, or 3 for RGB visibility (textured lights) */
+    /* Auxiliary per-sample outputs (Technique.aux), aux[(size_t)s * n + k] for
+     * sample s and the k-th of the n names; NULL when the technique has none. */
+    float *aux;
 } TechContext;
 
 typedef struct Technique {
@@ -59,7 +62,19 @@ typedef struct Technique {
      * called in parallel on disjoint ranges. */
     void (*evaluate)(const void *state, const TechContext *ctx, int begin, int end, float *out);
     void (*release)(void *state);
+    /* Names of auxiliary per-sample channels evaluate writes (NULL-terminated,
+     * or NULL for none), e.g. seed 001's subdivision level: the EXR stores
+     * them as aux.NAME, the record summarises them over the lit candidates. */
+    const char *const *aux;
 } Technique;
+
+/* Number of auxiliary channels a technique declares. */
+static inline int tech_aux_count(const Technique *t)
+{
+    int n = 0;
+    while (t->aux && t->aux[n]) n++;
+    return n;
+}
 
 /* Store one visibility for sample s in an evaluate's output (all channels). */
 static inline void tech_store(const TechContext *ctx, float *out, int begin, int s, float v)
