@@ -1,10 +1,14 @@
-/* lightview.c -- projections of shadow-map faces, their fitting to a target
- * point set (course §3.2.1 "fitting": the map covers only what is seen or
- * what exists), and world -> map lookups (see lightview.h). */
+/* lightview.c -- projections of shadow-map faces and their fitting to a
+ * target point set (course §3.2.1 "fitting": the map covers only what is
+ * seen or what exists): the scene's bounds, the visible receivers, or the
+ * intersection body B (lightbody.h); the warps of §3.2.2 on top (warp.h);
+ * z-partitioning into cascades (§3.2.3.1), one face per slice; texel-snapped
+ * stabilisation of uniform maps. Lookups are in lightview_lookup.c. */
 #include "resources/lightview.h"
 #include <float.h>
 #include <stdlib.h>
 #include <string.h>
+#include "resources/warp.h"
 
 #define MAX_TAN_PERSPECTIVE 3.7320508 /* tan 75 degrees: a 150-degree frustum at most */
 #define MARGIN_TEXELS 2.0             /* fitted extents grow by this much on each side */
@@ -22,13 +26,58 @@ const char *map_fit_name(MapFit f)
     return names[f];
 }
 
-/* ---- the target ----------------------------------------------------------- */
+LightViewParams lightview_params_default(void)
+{
+    return (LightViewParams){.warp_n = 1.0, .falloff = WARP_FALLOFF_LLOYD, .tsm_focus = 0.5, .cascades = 1,
+                             .split = SPLIT_PRACTICAL, .split_lambda = 0.5, .select = CASCADE_BY_DEPTH};
+}
+
+static bool is_warp(MapProjection p) { return p >= MAP_PROJ_PSM && p <= MAP_PROJ_LOGPSM; }
+static bool is_body(MapFit f) { return f == MAP_FIT_BODY || f == MAP_FIT_BODY_VISIBLE; }
+
+bool lightview_follows_camera(MapProjection projection, MapFit fit, const LightViewParams *p)
+{
+    return fit != MAP_FIT_SCENE && fit != MAP_FIT_NONE ? true : is_warp(projection) || (p && p->cascades > 1);
+}
+
+/* ---- splits (course §3.2.3.1) ---------------------------------------------- */
+
+static double split_at(SplitScheme s, double lambda, int i, int m, double zn, double zf)
+{
+    double t = (double)i / m, lg = zn * pow(zf / zn, t), un = zn + (zf - zn) * t;
+    if (s == SPLIT_LOG) return lg;          /* Lloyd et al. 2006 */
+    if (s == SPLIT_UNIFORM) return un;
+    return lambda * lg + (1.0 - lambda) * un; /* Zhang et al. 2006a, the practical split scheme */
+}
+
+/* With a pseudo-near plane z_p (Lloyd 2007 §5.1.8) the first slice is
+ * [z_n, z_p] and the scheme splits [z_p, z_f] into the other m - 1. */
+void lightview_splits(SplitScheme scheme, double lambda, int m, double z_n, double z_f, double pseudo_near,
+                      double *split)
+{
+    z_f = fmax(z_f, z_n);
+    z_n = fmax(z_n, 1e-9 * z_f); /* C_i = z_n r^(i/m) divides by z_n */
+    if (!(z_f > z_n)) z_f = z_n * (1.0 + 1e-9) + 1e-300;
+    int first = 0;
+    double lo = z_n;
+    split[0] = z_n;
+    if (pseudo_near > z_n && pseudo_near < z_f && m >= 2) {
+        split[1] = pseudo_near;
+        first = 1;
+        lo = pseudo_near;
+    }
+    for (int i = first + 1; i < m; i++) split[i] = split_at(scheme, lambda, i - first, m - first, lo, z_f);
+    split[m] = z_f;
+}
+
+/* ---- the target ------------------------------------------------------------- */
 
 typedef struct Target {
     dvec3 *pts;      /* what the map must cover laterally */
     int n;
     dvec3 bounds[8]; /* the scene's box corners: everything that can cast */
     double extent;   /* scene diagonal */
+    double z_min, z_max; /* view-depth range of the points (warps), within the camera's */
 } Target;
 
 static void box_corners(vec3 lo, vec3 hi, dvec3 *out)
@@ -36,24 +85,53 @@ static void box_corners(vec3 lo, vec3 hi, dvec3 *out)
     for (int k = 0; k < 8; k++) out[k] = d3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z);
 }
 
-static bool target_init(const Scene *sc, MapFit fit, const ViewSamples *vs, const uint8_t *cls, Target *t, Error *err)
+static void target_depths(Target *t, const ViewFrustum *vf, double d0, double d1)
+{
+    t->z_min = INFINITY;
+    t->z_max = -INFINITY;
+    for (int i = 0; i < t->n; i++) {
+        double d = view_depth(vf, t->pts[i]);
+        t->z_min = fmin(t->z_min, d);
+        t->z_max = fmax(t->z_max, d);
+    }
+    t->z_min = fmin(fmax(t->z_min, d0), d1);
+    t->z_max = fmin(fmax(t->z_max, t->z_min), d1);
+}
+
+/* The scene's box corners as the points (no receiver in view, an empty body). */
+static void target_bounds(Target *t)
+{
+    memcpy(t->pts, t->bounds, sizeof t->bounds);
+    t->n = 8;
+}
+
+/* Points of the fit over the view-depth slice [d0, d1] (the whole frustum
+ * when not partitioned): B's vertices, or the visible lit candidates. */
+static bool target_init(const Scene *sc, const Light *light, MapFit fit, const ViewSamples *vs, const uint8_t *cls,
+                        const ViewFrustum *vf, double d0, double d1, Target *t, Error *err)
 {
     memset(t, 0, sizeof *t);
     box_corners(sc->bounds_min, sc->bounds_max, t->bounds);
     t->extent = scene_extent(sc);
     int n = 0;
+    bool sliced = d0 > vf->near || d1 < vf->far;
     if (fit == MAP_FIT_VIEW && vs && cls)
-        for (int s = 0; s < vs->count; s++) n += cls[s] == SAMPLE_LIT_CANDIDATE;
-    /* no receiver in view (every pixel background or unlit): the scene's bounds */
-    t->pts = malloc(sizeof *t->pts * (size_t)(n > 8 ? n : 8));
+        for (int s = 0; s < vs->count; s++)
+            n += cls[s] == SAMPLE_LIT_CANDIDATE && (!sliced || (vs->depth_view[s] >= d0 && vs->depth_view[s] <= d1));
+    size_t cap = (size_t)(n > BODY_MAX_POINTS ? n : BODY_MAX_POINTS);
+    t->pts = malloc(sizeof *t->pts * cap);
     if (!t->pts) return error_set(err, "out of memory fitting the light's frustum");
-    if (n == 0) {
-        memcpy(t->pts, t->bounds, sizeof t->bounds);
-        t->n = 8;
-        return true;
+    if (fit == MAP_FIT_VIEW && n > 0) {
+        for (int s = 0; s < vs->count; s++)
+            if (cls[s] == SAMPLE_LIT_CANDIDATE && (!sliced || (vs->depth_view[s] >= d0 && vs->depth_view[s] <= d1)))
+                t->pts[t->n++] = d3_from(vs->p_world[s]);
+    } else if (is_body(fit) || (fit == MAP_FIT_VIEW && sliced)) {
+        BodyPlane cone[5];
+        int nc = light->kind == LIGHT_SPOT ? spot_cone_planes(light, cone) : 0;
+        t->n = body_points(vf, d0, d1, sc, cone, nc, t->pts, (int)cap);
     }
-    for (int s = 0; s < vs->count; s++)
-        if (cls[s] == SAMPLE_LIT_CANDIDATE) t->pts[t->n++] = d3_from(vs->p_world[s]);
+    if (t->n == 0) target_bounds(t);
+    target_depths(t, vf, d0, d1);
     return true;
 }
 
@@ -69,6 +147,10 @@ static bool face_finish(MapFace *f, const mat4 *proj, double n, double far, Erro
     f->raster.depth_far = far;
     if (!m4_invert(&f->raster.clip_from_world, &f->world_from_clip))
         return error_set(err, "the light's projection is singular (near %g, far %g)", n, far);
+    f->base_clip = f->raster.clip_from_world;
+    f->base_inv = f->world_from_clip;
+    f->base_half = 0.5 * fmax(f->r - f->l, f->t - f->b);
+    f->warp_n = INFINITY;
     return true;
 }
 
@@ -79,7 +161,7 @@ static bool face_perspective(MapFace *f, dvec3 eye, dvec3 axis, dvec3 up, const 
     memset(f, 0, sizeof *f);
     f->view_from_world = m4_look(eye, axis, up);
     f->axis_world = axis;
-    f->perspective = true;
+    f->perspective = f->base_perspective = true;
     f->l = ext[0]; f->r = ext[1]; f->b = ext[2]; f->t = ext[3];
     mat4 proj = m4_frustum(ext[0] * n, ext[1] * n, ext[2] * n, ext[3] * n, n, far);
     return face_finish(f, &proj, n, far, err);
@@ -110,6 +192,16 @@ static void face_paraboloid(MapFace *f, dvec3 eye, dvec3 axis, double n, double 
     f->r = f->t = 1.0;
 }
 
+/* How a single face is oriented and shaped beyond its target. */
+typedef struct FaceOpts {
+    bool aligned;   /* the light view's y axis follows `up` (the view direction), not a world axis */
+    dvec3 up;
+    bool square;    /* equal extents (a warp's base: its plane stays isotropic) */
+    bool stabilize; /* texel-snapped on a ladder of sizes (ortho) */
+} FaceOpts;
+
+static dvec3 face_up(const FaceOpts *o, dvec3 axis) { return o->aligned ? o->up : any_up(axis); }
+
 /* ---- extents of point sets ---------------------------------------------------- */
 
 /* Grow [lo, hi] by the margin, and to a minimum width. */
@@ -119,6 +211,31 @@ static void pad(double *lo, double *hi, int res, double min_width)
     w *= 1.0 + 2.0 * MARGIN_TEXELS / res;
     *lo = c - 0.5 * w;
     *hi = c + 0.5 * w;
+}
+
+static void make_square(double ext[4])
+{
+    double h = 0.5 * fmax(ext[1] - ext[0], ext[3] - ext[2]);
+    double cx = 0.5 * (ext[0] + ext[1]), cy = 0.5 * (ext[2] + ext[3]);
+    ext[0] = cx - h; ext[1] = cx + h; ext[2] = cy - h; ext[3] = cy + h;
+}
+
+/* Course §3.2.1: a constant orientation (the light view's axes are world-
+ * fixed, face_up) and texel-sized steps: the width is rounded up to a
+ * ladder 2^(k/4) of the scene's extent and the window's corner snapped to
+ * whole texels, so the texel grid stays put in world space while the body
+ * moves (it only jumps when the body outgrows a rung). */
+static void stabilize_extents(double ext[4], int res, double extent)
+{
+    double need = fmax(ext[1] - ext[0], ext[3] - ext[2]);
+    double k = ceil(4.0 * log2(fmax(need, 1e-300) / extent)), size = extent * exp2(k / 4.0);
+    while (size < need + 2.0 * (MARGIN_TEXELS + 1.0) * size / res) size *= exp2(0.25);
+    double texel = size / res;
+    for (int a = 0; a < 2; a++) {
+        double c = 0.5 * (ext[2 * a] + ext[2 * a + 1]);
+        ext[2 * a] = floor((c - 0.5 * size) / texel) * texel;
+        ext[2 * a + 1] = ext[2 * a] + size;
+    }
 }
 
 /* Tangent extents and depth range of pts in front of a perspective view;
@@ -160,7 +277,8 @@ static dvec3 centroid(const dvec3 *pts, int n)
 
 /* ---- per projection ------------------------------------------------------------ */
 
-static bool fit_perspective(LightView *lv, const Light *light, MapFit fit, const Target *tg, Error *err)
+static bool fit_perspective(MapFace *f, int res, const Light *light, MapFit fit, const Target *tg, const FaceOpts *o,
+                            Error *err)
 {
     dvec3 eye = d3_from(light->position), axis;
     double max_tan = MAX_TAN_PERSPECTIVE;
@@ -172,7 +290,8 @@ static bool fit_perspective(LightView *lv, const Light *light, MapFit fit, const
     } else {
         axis = d3_normalize_or(d3_sub(centroid(tg->pts, tg->n), eye), d3(0, -1, 0));
     }
-    mat4 view = m4_look(eye, axis, any_up(axis));
+    dvec3 up = face_up(o, axis);
+    mat4 view = m4_look(eye, axis, up);
     double ext[4], dmax;
     tangent_extents(&view, tg->pts, tg->n, max_tan, ext, &dmax);
     double dbound;
@@ -185,19 +304,21 @@ static bool fit_perspective(LightView *lv, const Light *light, MapFit fit, const
         dmax = dbound;
     }
     double far = fmax(dmax, 1e-6 * tg->extent) * 1.01;
-    pad(&ext[0], &ext[1], lv->res, 1e-6);
-    pad(&ext[2], &ext[3], lv->res, 1e-6);
-    lv->num_faces = 1;
-    return face_perspective(&lv->face[0], eye, axis, any_up(axis), ext, near_plane(&view, tg->bounds, far), far, err);
+    pad(&ext[0], &ext[1], res, 1e-6);
+    pad(&ext[2], &ext[3], res, 1e-6);
+    if (o->square) make_square(ext);
+    return face_perspective(f, eye, axis, up, ext, near_plane(&view, tg->bounds, far), far, err);
 }
 
-static bool fit_ortho(LightView *lv, const Light *light, MapFit fit, const Target *tg, Error *err)
+static bool fit_ortho(MapFace *f, int res, const Light *light, MapFit fit, const Target *tg, const FaceOpts *o,
+                      Error *err)
 {
     dvec3 axis = d3_from(light->direction);
     dvec3 centre = d3_scale(d3_add(tg->bounds[0], tg->bounds[7]), 0.5);
     double radius = 0.5 * d3_len(d3_sub(tg->bounds[7], tg->bounds[0]));
     dvec3 eye = d3_madd(centre, axis, -2.0 * fmax(radius, 1e-30)); /* outside the scene, looking in */
-    mat4 view = m4_look(eye, axis, any_up(axis));
+    dvec3 up = face_up(o, axis);
+    mat4 view = m4_look(eye, axis, up);
     double ext[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY}, near = INFINITY, far = 0.0;
     for (int i = 0; i < tg->n; i++) {
         dvec4 v = m4_apply(&view, tg->pts[i]);
@@ -215,10 +336,14 @@ static bool fit_ortho(LightView *lv, const Light *light, MapFit fit, const Targe
         ext[0] = c.x - radius; ext[1] = c.x + radius; ext[2] = c.y - radius; ext[3] = c.y + radius;
     }
     double depth_pad = 1e-3 * fmax(radius, 1e-30);
-    pad(&ext[0], &ext[1], lv->res, 1e-6 * tg->extent);
-    pad(&ext[2], &ext[3], lv->res, 1e-6 * tg->extent);
-    lv->num_faces = 1;
-    return face_ortho(&lv->face[0], eye, axis, any_up(axis), ext, fmax(near - depth_pad, 0.0), far + depth_pad, err);
+    if (o->stabilize) {
+        stabilize_extents(ext, res, tg->extent);
+    } else {
+        pad(&ext[0], &ext[1], res, 1e-6 * tg->extent);
+        pad(&ext[2], &ext[3], res, 1e-6 * tg->extent);
+    }
+    if (o->square) make_square(ext);
+    return face_ortho(f, eye, axis, up, ext, fmax(near - depth_pad, 0.0), far + depth_pad, err);
 }
 
 /* Range of radial distances from the centre to the scene: near, far. */
@@ -282,118 +407,135 @@ static MapProjection resolve_auto(const Light *light, const Target *tg)
     }
 }
 
-bool lightview_fit(const Scene *scene, const Light *light, MapProjection projection, MapFit fit, int res,
-                   const ViewSamples *vs, const uint8_t *cls, LightView *lv, Error *err)
+/* ---- one face: base projection, then the warp ------------------------------------ */
+
+typedef struct FitJob {
+    const Scene *scene;
+    const Light *light;
+    MapProjection projection; /* asked for (AUTO resolved per target) */
+    MapFit fit;
+    const LightViewParams *params;
+    const ViewFrustum *view;
+} FitJob;
+
+static bool fit_face(LightView *lv, int index, const FitJob *j, const Target *tg, Error *err)
 {
-    memset(lv, 0, sizeof *lv);
+    bool directional = j->light->kind == LIGHT_DIRECTIONAL;
+    bool warp = is_warp(j->projection);
+    FaceOpts o = {.aligned = !j->params->stabilize && (warp || is_body(j->fit) || j->params->cascades > 1),
+                  .up = j->view->fwd, .square = warp, .stabilize = j->params->stabilize};
+    MapFace *f = &lv->face[index];
+    bool ok = directional ? fit_ortho(f, lv->res, j->light, j->fit, tg, &o, err)
+                          : fit_perspective(f, lv->res, j->light, j->fit, tg, &o, err);
+    if (!ok || !warp) return ok;
+    WarpSetup w = {.kind = j->projection, .params = j->params, .view = j->view, .directional = directional,
+                   .light_axis = directional ? d3_normalize_or(d3_from(j->light->direction), d3(0, -1, 0))
+                                             : f->axis_world,
+                   .light_pos = d3_from(j->light->position), .pts = tg->pts, .n = tg->n,
+                   .z_min = tg->z_min, .z_max = tg->z_max};
+    return warp_face(f, lv->res, &w, err);
+}
+
+/* ---- refusals -------------------------------------------------------------------- */
+
+static bool check_request(const Light *light, MapProjection p, MapFit fit, int res, const LightViewParams *lp,
+                          Error *err)
+{
     if (res < 1 || res > RASTER_MAX_SIZE) return error_set(err, "map_size %d outside [1, %d]", res, RASTER_MAX_SIZE);
     bool directional = light->kind == LIGHT_DIRECTIONAL;
-    if (directional && projection != MAP_PROJ_AUTO && projection != MAP_PROJ_ORTHO)
-        return error_set(err, "projection %s needs a light with a position; a directional light takes ortho",
-                         map_projection_name(projection));
-    if (!directional && projection == MAP_PROJ_ORTHO)
+    if (directional && p != MAP_PROJ_AUTO && p != MAP_PROJ_ORTHO && !is_warp(p))
+        return error_set(err, "projection %s needs a light with a position; a directional light takes ortho or a "
+                              "warp (psm, lispsm, tsm, logpsm)", map_projection_name(p));
+    if (!directional && p == MAP_PROJ_ORTHO)
         return error_set(err, "projection ortho is for directional lights; a %s light takes perspective, cube or "
                               "paraboloid", light_kind_name(light->kind));
-    Target tg;
-    if (!target_init(scene, fit, vs, cls, &tg, err)) return false;
+    int m = lp->cascades > 0 ? lp->cascades : 1;
+    if (m > LIGHTVIEW_MAX_CASCADES) return error_set(err, "cascades %d outside [1, %d]", m, LIGHTVIEW_MAX_CASCADES);
+    if ((m > 1 || lp->split == SPLIT_FACES) && (p == MAP_PROJ_CUBE || p == MAP_PROJ_PARABOLOID))
+        return error_set(err, "cascades need a single-face projection per slice, not %s", map_projection_name(p));
+    if ((m > 1 || lp->split == SPLIT_FACES) && fit != MAP_FIT_VIEW && !is_body(fit))
+        return error_set(err, "cascades split the view: fit must be body, body_visible or view, not %s",
+                         map_fit_name(fit));
+    if (lp->stabilize && (!directional || (p != MAP_PROJ_AUTO && p != MAP_PROJ_ORTHO)))
+        return error_set(err, "stabilize keeps the texels of uniform (ortho) maps of directional lights still; "
+                              "projection %s of a %s light cannot be", map_projection_name(p),
+                         light_kind_name(light->kind));
+    if (!(lp->blend >= 0.0 && lp->blend <= 0.5)) return error_set(err, "cascade_blend %g outside [0, 0.5]", lp->blend);
+    return true;
+}
+
+/* ---- the light view --------------------------------------------------------------- */
+
+/* The farthest visible sample's view depth (course §3.2.1: a far plane
+ * from visibility; exact here, the depths are in memory). */
+static double visible_far(const ViewSamples *vs, double near, double far)
+{
+    double d = 0.0;
+    for (int s = 0; vs && s < vs->count; s++)
+        if (vs->object[s] >= 0) d = fmax(d, vs->depth_view[s]);
+    return d > near ? fmin(d * (1.0 + 1e-6), far) : far; /* nothing visible: the camera's far plane */
+}
+
+static bool fit_cascades(LightView *lv, const FitJob *j, const ViewSamples *vs, const uint8_t *cls, double z_n,
+                         double z_f, Error *err)
+{
+    const LightViewParams *lp = j->params;
+    int m = lp->cascades > 1 ? lp->cascades : 1;
+    lightview_splits(lp->split, lp->split_lambda, m, z_n, z_f, lp->pseudo_near, lv->split);
+    lv->num_cascades = m;
+    lv->num_faces = m;
+    lv->view_eye = j->view->eye;
+    lv->view_fwd = j->view->fwd;
+    lv->select = lp->select;
+    lv->blend = lp->blend;
+    for (int i = 0; i < m; i++) {
+        Target tg;
+        if (!target_init(j->scene, j->light, j->fit, vs, cls, j->view, lv->split[i], lv->split[i + 1], &tg, err))
+            return false;
+        bool ok = fit_face(lv, i, j, &tg, err);
+        free(tg.pts);
+        if (!ok) return false;
+    }
+    return true;
+}
+
+bool lightview_fit_with(const Scene *scene, const Light *light, MapProjection projection, MapFit fit, int res,
+                        const LightViewParams *params, const ViewSamples *vs, const uint8_t *cls, LightView *lv,
+                        Error *err)
+{
+    memset(lv, 0, sizeof *lv);
+    LightViewParams lp = params ? *params : lightview_params_default();
+    if (!check_request(light, projection, fit, res, &lp, err)) return false;
+    ViewFrustum vf = view_frustum(&scene->camera);
+    double z_f = fit == MAP_FIT_BODY_VISIBLE ? visible_far(vs, vf.near, vf.far) : vf.far;
+    vf.far = z_f;
     lv->res = res;
     lv->origin_world = d3_from(light->position);
+    lv->light_dir = d3_normalize_or(d3_from(light->direction), d3(0, -1, 0));
+    Target tg;
+    if (!target_init(scene, light, fit, vs, cls, &vf, vf.near, vf.far, &tg, err)) return false;
     lv->projection = projection == MAP_PROJ_AUTO ? resolve_auto(light, &tg) : projection;
+    FitJob j = {scene, light, lv->projection, fit, &lp, &vf};
     bool ok;
-    switch (lv->projection) {
-    case MAP_PROJ_ORTHO: ok = fit_ortho(lv, light, fit, &tg, err); break;
-    case MAP_PROJ_CUBE: ok = fit_cube(lv, light, &tg, err); break;
-    case MAP_PROJ_PARABOLOID: ok = fit_paraboloid(lv, light, &tg); break;
-    default: ok = fit_perspective(lv, light, fit, &tg, err); break;
+    if (lp.cascades > 1) {
+        ok = fit_cascades(lv, &j, vs, cls, vf.near, vf.far, err);
+    } else {
+        switch (lv->projection) {
+        case MAP_PROJ_CUBE: ok = fit_cube(lv, light, &tg, err); break;
+        case MAP_PROJ_PARABOLOID: ok = fit_paraboloid(lv, light, &tg); break;
+        default:
+            lv->num_faces = 1;
+            ok = fit_face(lv, 0, &j, &tg, err);
+            break;
+        }
     }
     free(tg.pts);
     return ok;
 }
 
-/* ---- lookups --------------------------------------------------------------------- */
-
-static int choose_face(const LightView *lv, dvec3 p)
+bool lightview_fit(const Scene *scene, const Light *light, MapProjection projection, MapFit fit, int res,
+                   const ViewSamples *vs, const uint8_t *cls, LightView *lv, Error *err)
 {
-    dvec3 d = d3_sub(p, lv->origin_world);
-    if (lv->projection == MAP_PROJ_PARABOLOID) return d3_dot(d, lv->cube_axes[0]) >= 0.0 ? 0 : 1;
-    if (lv->projection != MAP_PROJ_CUBE) return 0;
-    double ax = fabs(d.x), ay = fabs(d.y), az = fabs(d.z);
-    if (ax >= ay && ax >= az) return d.x >= 0.0 ? 0 : 1;
-    if (ay >= az) return d.y >= 0.0 ? 2 : 3;
-    return d.z >= 0.0 ? 4 : 5;
-}
-
-MapCoord lightview_locate_on(const LightView *lv, int face, dvec3 p)
-{
-    const MapFace *f = &lv->face[face];
-    MapCoord mc = {.face = face};
-    double xn, yn;
-    if (f->paraboloid) {
-        dvec4 v = m4_apply(&f->view_from_world, p);
-        double r;
-        paraboloid_ndc(d3(v.x, v.y, v.z), &xn, &yn, &r);
-        mc.depth_linear = r;
-        double range = f->raster.depth_far - f->raster.depth_near;
-        mc.z_ndc = (r - f->raster.depth_near) / range;
-        mc.inside = v.z <= 0.0;
-    } else {
-        dvec4 c = m4_apply(&f->raster.clip_from_world, p);
-        const double *row = f->raster.depth_row;
-        mc.depth_linear = row[0] * p.x + row[1] * p.y + row[2] * p.z + row[3];
-        if (!(c.w > 0.0)) return mc; /* behind a perspective face's eye */
-        xn = c.x / c.w;
-        yn = c.y / c.w;
-        mc.z_ndc = c.z / c.w;
-        mc.inside = true;
-    }
-    mc.s = (xn + 1.0) * 0.5 * lv->res;
-    mc.t = (yn + 1.0) * 0.5 * lv->res;
-    mc.inside = mc.inside && mc.s >= 0.0 && mc.s < lv->res && mc.t >= 0.0 && mc.t < lv->res && mc.z_ndc >= 0.0 &&
-                mc.z_ndc <= 1.0;
-    return mc;
-}
-
-MapCoord lightview_locate(const LightView *lv, dvec3 p_world)
-{
-    return lightview_locate_on(lv, choose_face(lv, p_world), p_world);
-}
-
-void lightview_texel_ray(const LightView *lv, int face, double s, double t, dvec3 *org, dvec3 *dir)
-{
-    const MapFace *f = &lv->face[face];
-    double xn = 2.0 * s / lv->res - 1.0, yn = 2.0 * t / lv->res - 1.0;
-    if (f->paraboloid) { /* inverse of paraboloid_ndc: the unit direction in view space */
-        double k = 1.0 / (1.0 + xn * xn + yn * yn);
-        dvec3 dv = d3(2.0 * xn * k, 2.0 * yn * k, -(1.0 - xn * xn - yn * yn) * k);
-        const double(*m)[4] = f->view_from_world.m; /* rotation part; its transpose maps back */
-        *dir = d3(m[0][0] * dv.x + m[1][0] * dv.y + m[2][0] * dv.z, m[0][1] * dv.x + m[1][1] * dv.y + m[2][1] * dv.z,
-                  m[0][2] * dv.x + m[1][2] * dv.y + m[2][2] * dv.z);
-        *org = lv->origin_world;
-        return;
-    }
-    dvec4 a = m4_apply4(&f->world_from_clip, (dvec4){xn, yn, 0.0, 1.0});
-    dvec4 b = m4_apply4(&f->world_from_clip, (dvec4){xn, yn, 1.0, 1.0});
-    *org = d3(a.x / a.w, a.y / a.w, a.z / a.w);
-    *dir = d3_normalize_or(d3_sub(d3(b.x / b.w, b.y / b.w, b.z / b.w), *org), f->axis_world);
-}
-
-double lightview_texel_world(const LightView *lv, const MapCoord *mc)
-{
-    const MapFace *f = &lv->face[mc->face];
-    double w = fmax(f->r - f->l, f->t - f->b) / lv->res;
-    if (f->perspective) return w * mc->depth_linear;
-    if (f->paraboloid) { /* u = tan(theta/2): d theta = du (1 + cos theta), 1 + cos = 2 / (1 + rho^2) */
-        double xn = 2.0 * mc->s / lv->res - 1.0, yn = 2.0 * mc->t / lv->res - 1.0;
-        return mc->depth_linear * w * 2.0 / (1.0 + xn * xn + yn * yn);
-    }
-    return w;
-}
-
-double lightview_ndc_per_world(const LightView *lv, const MapCoord *mc)
-{
-    const MapFace *f = &lv->face[mc->face];
-    double n = f->raster.depth_near, far = f->raster.depth_far;
-    if (!f->perspective) return 1.0 / (far - n);
-    double d = fmax(mc->depth_linear, n); /* z = f/(f-n) (1 - n/d): dz/dd = f n / ((f-n) d^2) */
-    return far * n / ((far - n) * d * d);
+    LightViewParams lp = lightview_params_default();
+    return lightview_fit_with(scene, light, projection, fit, res, &lp, vs, cls, lv, err);
 }

@@ -24,15 +24,82 @@ typedef enum MapProjection {
     MAP_PROJ_ORTHO,
     MAP_PROJ_CUBE,
     MAP_PROJ_PARABOLOID,
+    /* Warped single maps (course §3.2.2) on a base projection (ortho for a
+     * directional light, else the light's perspective): */
+    MAP_PROJ_PSM,         /* Stamminger & Drettakis 2002: the map taken in the eye's post-perspective space */
+    MAP_PROJ_LISPSM,      /* Wimmer et al. 2004: a perspective warp along the light plane, free n */
+    MAP_PROJ_TSM,         /* Martin & Tan 2004: the same warp with n from the 80% focus rule */
+    MAP_PROJ_LOGPSM,      /* Lloyd et al. 2008: perspective across, logarithmic along the warp axis (ray cast) */
 } MapProjection;
-#define MAP_PROJ_NAMES "auto", "perspective", "ortho", "cube", "paraboloid"
+#define MAP_PROJ_NAMES "auto", "perspective", "ortho", "cube", "paraboloid", "psm", "lispsm", "tsm", "logpsm"
+#define MAP_PROJ_COUNT 9
 
 typedef enum MapFit {
     MAP_FIT_SCENE, /* the bounds of all geometry */
     MAP_FIT_VIEW,  /* the visible lit-candidate view samples (depth range starts at the casters) */
     MAP_FIT_NONE,  /* the light's own frustum: a spot's cone, the scene's bounding sphere */
+    MAP_FIT_BODY,  /* the intersection body B: view frustum inside the scene's bounds (course §3.2.1) */
+    MAP_FIT_BODY_VISIBLE, /* B with its far plane at the farthest visible sample (exact on the CPU) */
 } MapFit;
-#define MAP_FIT_NAMES "scene", "view", "none"
+#define MAP_FIT_NAMES "scene", "view", "none", "body", "body_visible"
+#define MAP_FIT_COUNT 5
+
+/* How a perspective warp's n follows the angle gamma between the view and
+ * light directions (course §3.2.2.3); zero is Lloyd's, the cookbook's pick. */
+typedef enum WarpFalloff {
+    WARP_FALLOFF_LLOYD,     /* Lloyd 2007 thesis §5.2.1: eta(gamma), uniform below theta/3 */
+    WARP_FALLOFF_SIN_GAMMA, /* Wimmer 2004: n_opt / sin(gamma) */
+    WARP_FALLOFF_NONE,      /* n_opt at every angle */
+} WarpFalloff;
+#define WARP_FALLOFF_NAMES "lloyd", "sin_gamma", "none"
+
+/* Z-partitioning split positions C_i (course §3.2.3.1). */
+typedef enum SplitScheme {
+    SPLIT_PRACTICAL, /* Zhang et al. 2006: lambda log + (1 - lambda) uniform */
+    SPLIT_LOG,       /* Lloyd et al. 2006: C_i = z_n (z_f / z_n)^(i / m) */
+    SPLIT_UNIFORM,   /* C_i = z_n + (z_f - z_n) i / m */
+    SPLIT_FACES,     /* frustum-face partitioning (course §3.2.3.2): one map per light-facing frustum face */
+} SplitScheme;
+#define SPLIT_SCHEME_NAMES "practical", "log", "uniform", "faces"
+
+/* Which cascade a point uses (course §3.2.3.1). */
+typedef enum CascadeSelect {
+    CASCADE_BY_DEPTH,      /* the slice holding its view depth */
+    CASCADE_BY_PROJECTION, /* the nearest cascade whose map contains it (Zhang 2009: light near the view axis) */
+} CascadeSelect;
+#define CASCADE_SELECT_NAMES "depth", "projection"
+
+#define LIGHTVIEW_MAX_CASCADES 16
+
+/* What shapes a light view beyond its projection, fit and size; all-zero
+ * is a valid choice (it means the defaults). Lengths in world units. */
+typedef struct LightViewParams {
+    double warp_n;        /* perspective warps: n as a multiple of the falloff's n (0: 1, i.e. n_opt) */
+    WarpFalloff falloff;
+    double pseudo_near;   /* Lloyd 2007 §5.1.8-5.1.9: warp and splits computed as if z_n were this (0: off) */
+    double tsm_focus;     /* TSM: focus point at this fraction of the body's view depth range (0: 0.5) */
+    bool stabilize;       /* uniform maps: world-fixed orientation, texel-snapped (course §3.2.1) */
+    int cascades;         /* z-partitions, 1 to LIGHTVIEW_MAX_CASCADES (0: 1) */
+    SplitScheme split;
+    double split_lambda;  /* practical scheme's weight of the log scheme, [0, 1] */
+    CascadeSelect select;
+    double blend;         /* fraction of each slice, at its far end, dithered into the next one [0, 0.5] */
+} LightViewParams;
+
+LightViewParams lightview_params_default(void);
+
+typedef enum MapWarp { MAP_WARP_NONE, MAP_WARP_HOMOGRAPHY, MAP_WARP_LOG } MapWarp;
+
+/* The logarithmic parametrisation in the warp's frame (x', y') = (q.b, q.a)
+ * of base NDC q: with w = y' - y_min + n,
+ *   u = ku (x' - x_c) / w + cu,   v = kv ln(1 + (y' - y_min) / n) / ln(1 + D / n) + cv
+ * (course §3.2.2.2: s = ln(z / z_n) / ln(z_f / z_n) when the view is
+ * perpendicular to the light and n = z_n; linear in y' when n is infinite). */
+typedef struct LogWarp {
+    double a[2], b[2];   /* warp axis and lateral axis in base NDC (unit) */
+    double x_c, y_min, D, n;
+    double ku, cu, kv, cv;
+} LogWarp;
 
 typedef struct MapFace {
     RasterView raster;     /* clip_from_world (or view for paraboloid), depth_row, depth range */
@@ -44,6 +111,24 @@ typedef struct MapFace {
      * world units at any depth): x in [l, r], y in [b, t]. */
     double l, r, b, t;
     dvec3 axis_world;      /* the direction the face looks (unit) */
+    /* Warped faces (course §3.2.2): map NDC (u, v) is a function of the base
+     * projection's NDC (x_b, y_b) -- a homography H for PSM, LiSPSM, TSM and
+     * uniform maps fitted in the warp's basis (then folded into
+     * clip_from_world, so the rasterizer draws them), or the logarithmic
+     * map (ray cast; clip_from_world is then the base projection). Depth
+     * stays the base's: linear depth along the light, and z_ndc the base's
+     * (the clip z is the base's times w_min / w, w the homography's
+     * denominator, w >= w_min > 0 on B, so 0 <= z <= w clips as the base
+     * does; maps of ndc depth are rescaled per texel to the base's z_ndc). */
+    MapWarp warp;
+    mat4 base_clip, base_inv; /* world <-> the base projection's clip space */
+    bool base_perspective; /* the base is the light's perspective (else ortho) */
+    double base_half;      /* half width of the (square) base: world units, or tangent for perspective */
+    double H[3][3], H_inv[3][3], w_min;
+    LogWarp log;
+    double warp_n;         /* the warp's n in base NDC units (INFINITY: uniform; 0: PSM, centred at the eye) */
+    double warp_gamma;     /* angle between the view and light directions (radians) */
+    bool warp_fallback;    /* the asked-for warp was singular here and fell back (PSM: to LiSPSM at eta = 1) */
 } MapFace;
 
 typedef struct LightView {
@@ -54,12 +139,37 @@ typedef struct LightView {
     MapFace face[LIGHTVIEW_MAX_FACES];
     dvec3 origin_world;       /* the light's centre (not used by ortho lookups) */
     dvec3 cube_axes[3];       /* cube/paraboloid: the world axes faces are chosen by */
+    /* Z-partitioned views (num_cascades > 1): face i covers view depths
+     * [split[i], split[i+1]] (course §3.2.3.1). */
+    int num_cascades;
+    double split[LIGHTVIEW_MAX_CASCADES + 1];
+    dvec3 view_eye, view_fwd;
+    CascadeSelect select;
+    double blend;
+    /* Frustum-face partitions: face i serves the points whose light ray meets
+     * the view frustum's light-facing face i first (course §3.2.3.2). */
+    bool face_partition;
+    int num_face_planes;
+    double face_plane[6][4];  /* the frustum's planes, inward normals: n.p + d >= 0 inside */
+    int face_of_plane[6];     /* map face of each light-facing plane, -1 for the others */
+    dvec3 light_dir;          /* directional: travel direction; else unused (rays from origin_world) */
 } LightView;
 
 /* Fit the map of `light` to the target given by `fit`. `vs` and `cls` are
  * needed only for MAP_FIT_VIEW (else NULL). */
 bool lightview_fit(const Scene *scene, const Light *light, MapProjection projection, MapFit fit, int res,
                    const ViewSamples *vs, const uint8_t *cls, LightView *lv, Error *err);
+/* The same with warps, cascades and stabilisation. The camera is the
+ * scene's; `vs` is needed for MAP_FIT_VIEW and MAP_FIT_BODY_VISIBLE. */
+bool lightview_fit_with(const Scene *scene, const Light *light, MapProjection projection, MapFit fit, int res,
+                        const LightViewParams *params, const ViewSamples *vs, const uint8_t *cls, LightView *lv,
+                        Error *err);
+/* Whether a fit or projection depends on the camera (for resource keys). */
+bool lightview_follows_camera(MapProjection projection, MapFit fit, const LightViewParams *params);
+/* Split positions C_0..C_m over view depths [z_n, z_f] (course §3.2.3.1);
+ * z_n is kept above 1e-9 z_f so the log scheme stays finite. */
+void lightview_splits(SplitScheme scheme, double lambda, int m, double z_n, double z_f, double pseudo_near,
+                      double *split);
 
 /* Where a world point falls in the map. */
 typedef struct MapCoord {
@@ -68,6 +178,7 @@ typedef struct MapCoord {
     double depth_linear; /* view depth (or radial distance for paraboloid faces), world units */
     double z_ndc;        /* post-projective depth of the same point */
     bool inside;         /* within the face's texels and depth range */
+    double warp_w;       /* homography faces: its denominator at the point over the base's w (else 1) */
 } MapCoord;
 
 MapCoord lightview_locate(const LightView *lv, dvec3 p_world);
@@ -83,5 +194,8 @@ double lightview_ndc_per_world(const LightView *lv, const MapCoord *mc);
 
 const char *map_projection_name(MapProjection p);
 const char *map_fit_name(MapFit f);
+/* The base NDC of a point on a warped face's base projection; false when
+ * the point is behind a perspective base's eye. */
+bool lightview_base_ndc(const MapFace *f, dvec3 p_world, double *x_b, double *y_b, double *z_ndc);
 
 #endif

@@ -4,17 +4,22 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/hash.h"
+#include "resources/logmap.h"
 #include "resources/standard.h"
 
 ShadowMapSpec shadowmap_spec_default(void)
 {
     return (ShadowMapSpec){.res = 1024, .projection = MAP_PROJ_AUTO, .fit = MAP_FIT_SCENE,
-                           .depth = RASTER_DEPTH_LINEAR, .layer = MAP_LAYER_FIRST, .cull = RASTER_CULL_NONE};
+                           .depth = RASTER_DEPTH_LINEAR, .layer = MAP_LAYER_FIRST, .cull = RASTER_CULL_NONE,
+                           .view = lightview_params_default()};
 }
 
 /* Faces the map may need: AUTO may turn a point or sphere light into a cube. */
-static int max_faces(const Light *light, MapProjection p)
+static int max_faces(const Light *light, const ShadowMapSpec *spec)
 {
+    MapProjection p = spec->projection;
+    if (spec->view.split == SPLIT_FACES) return 6;
+    if (spec->view.cascades > 1) return spec->view.cascades;
     if (p == MAP_PROJ_CUBE) return 6;
     if (p == MAP_PROJ_PARABOLOID) return 2;
     if (p == MAP_PROJ_AUTO && (light->kind == LIGHT_POINT || light->kind == LIGHT_SPHERE)) return 6;
@@ -23,7 +28,7 @@ static int max_faces(const Light *light, MapProjection p)
 
 size_t shadowmap_bytes_for(const Light *light, const ShadowMapSpec *spec)
 {
-    size_t texels = (size_t)max_faces(light, spec->projection) * (size_t)spec->res * (size_t)spec->res;
+    size_t texels = (size_t)max_faces(light, spec) * (size_t)spec->res * (size_t)spec->res;
     return texels * (sizeof(float) + (spec->triangle_ids ? sizeof(int32_t) : 0));
 }
 
@@ -85,6 +90,26 @@ static const ShadowMap *peel_source(const MapArgs *a, Error *err)
     return res_shadow_map(a->rm, a->scene, a->light_index, &first, err);
 }
 
+/* A homography-warped face rasterizes z_ndc scaled by w_min / w (lightview.h);
+ * w is constant along a light ray, so each texel's depth times w / w_min at
+ * its centre is the base projection's z_ndc of the surface there, what the
+ * lookups compare with. */
+static void base_ndc_depths(const LightView *lv, int face, float *depth)
+{
+    const MapFace *f = &lv->face[face];
+    if (f->warp != MAP_WARP_HOMOGRAPHY) return;
+    const double(*Hi)[3] = f->H_inv;
+#pragma omp parallel for schedule(static)
+    for (int j = 0; j < lv->res; j++) {
+        double v = 2.0 * (j + 0.5) / lv->res - 1.0;
+        for (int i = 0; i < lv->res; i++) {
+            double u = 2.0 * (i + 0.5) / lv->res - 1.0, w = 1.0 / (Hi[2][0] * u + Hi[2][1] * v + Hi[2][2]);
+            float *d = &depth[(size_t)j * lv->res + i];
+            if (isfinite(*d)) *d = (float)fmin(fmax(*d * w / f->w_min, 0.0), 1.0);
+        }
+    }
+}
+
 static bool render_faces(ShadowMap *m, const MapArgs *a, const ShadowMap *under, Error *err)
 {
     RasterMesh *meshes = malloc(sizeof *meshes * (size_t)(a->scene->num_objects > 0 ? a->scene->num_objects : 1));
@@ -97,6 +122,7 @@ static bool render_faces(ShadowMap *m, const MapArgs *a, const ShadowMap *under,
         RasterOptions opt = raster_options(&a->spec, under ? under->depth + f * face_texels : NULL);
         RasterStats st;
         ok = raster_depth(meshes, nm, &m->view.face[f].raster, &opt, &db, &st, err);
+        if (ok && a->spec.depth == RASTER_DEPTH_NDC) base_ndc_depths(&m->view, f, db.depth);
         for (size_t i = 0; opt.test == RASTER_FARTHEST && i < face_texels; i++) /* the map's empty: +INFINITY */
             if (db.depth[i] == -INFINITY) db.depth[i] = INFINITY;
         m->stats.triangles_in += st.triangles_in;
@@ -115,19 +141,22 @@ static void *build_map(const void *args, Error *err)
     const Scene *sc = a->scene;
     const ViewSamples *vs = NULL;
     const uint8_t *cls = NULL;
-    if (a->spec.fit == MAP_FIT_VIEW) {
+    if (a->spec.fit == MAP_FIT_VIEW || a->spec.fit == MAP_FIT_BODY_VISIBLE) {
         vs = res_view_samples(a->rm, sc, err);
         cls = vs ? res_classes(a->rm, sc, a->light_index, err) : NULL;
         if (!cls) return NULL;
     }
+    bool cast = a->spec.projection == MAP_PROJ_LOGPSM;
+    const RtScene *casters = cast ? res_bvh(a->rm, sc, RT_CASTERS, err) : NULL;
+    if (cast && !casters) return NULL;
     const ShadowMap *under = a->spec.layer == MAP_LAYER_PEELED ? peel_source(a, err) : NULL;
     if (a->spec.layer == MAP_LAYER_PEELED && !under) return NULL;
     ShadowMap *m = calloc(1, sizeof *m);
     if (!m) { error_set(err, "out of memory"); return NULL; }
     m->spec = a->spec;
     m->key = a->key;
-    if (!lightview_fit(sc, &sc->lights[a->light_index], a->spec.projection, a->spec.fit, a->spec.res, vs, cls,
-                       &m->view, err)) {
+    if (!lightview_fit_with(sc, &sc->lights[a->light_index], a->spec.projection, a->spec.fit, a->spec.res,
+                            &a->spec.view, vs, cls, &m->view, err)) {
         free(m);
         return NULL;
     }
@@ -141,11 +170,26 @@ static void *build_map(const void *args, Error *err)
         map_destroy(m);
         return NULL;
     }
-    if (!render_faces(m, a, under, err)) {
+    if (!(cast ? logmap_cast(m, sc, casters, err) : render_faces(m, a, under, err))) {
         map_destroy(m);
         return NULL;
     }
     return m;
+}
+
+/* The view parameters that shape this map (the others zeroed), so a sweep
+ * over, say, tsm_focus reuses a LiSPSM map. */
+static LightViewParams relevant_params(const ShadowMapSpec *s)
+{
+    LightViewParams v = s->view, z = {0};
+    MapProjection p = s->projection;
+    bool warp = p >= MAP_PROJ_PSM && p <= MAP_PROJ_LOGPSM, partitioned = v.cascades > 1 || v.split == SPLIT_FACES;
+    if (!warp || p == MAP_PROJ_PSM) { v.warp_n = z.warp_n; v.falloff = z.falloff; }
+    if (!warp && !partitioned) v.pseudo_near = z.pseudo_near;
+    if (p != MAP_PROJ_TSM) v.tsm_focus = z.tsm_focus;
+    if (!partitioned) { v.split = z.split; v.select = z.select; v.blend = z.blend; v.cascades = 1; }
+    if (!partitioned || v.split != SPLIT_PRACTICAL) v.split_lambda = z.split_lambda;
+    return v;
 }
 
 static uint64_t map_key(const Scene *sc, int light_index, const ShadowMapSpec *s)
@@ -155,10 +199,15 @@ static uint64_t map_key(const Scene *sc, int light_index, const ShadowMapSpec *s
     hash_u64(&h, sc->hash_casters);                 /* what is drawn */
     hash_u64(&h, sc->hash_geometry);                /* the bounds it is fitted to */
     hash_u64(&h, sc->hash_lights[light_index]);
-    if (s->fit == MAP_FIT_VIEW) hash_u64(&h, sc->hash_camera);
+    if (lightview_follows_camera(s->projection, s->fit, &s->view)) hash_u64(&h, sc->hash_camera);
     const int64_t fields[] = {s->res, s->projection, s->fit, s->depth, s->depth_bits, s->layer,
                               s->cull, s->triangle_ids, s->conservative};
     for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) hash_u64(&h, (uint64_t)fields[i]);
+    LightViewParams v = relevant_params(s);
+    const int64_t ints[] = {v.falloff, v.stabilize, v.cascades, v.split, v.select};
+    for (size_t i = 0; i < sizeof ints / sizeof ints[0]; i++) hash_u64(&h, (uint64_t)ints[i]);
+    const double reals[] = {v.warp_n, v.pseudo_near, v.tsm_focus, v.split_lambda, v.blend};
+    for (size_t i = 0; i < sizeof reals / sizeof reals[0]; i++) hash_f64(&h, reals[i]);
     return hash_final(&h);
 }
 
@@ -179,12 +228,20 @@ const ShadowMap *res_shadow_map(ResourceManager *rm, const Scene *scene, int lig
     size_t bytes = shadowmap_bytes_for(light, spec);
     if (bytes > SHADOWMAP_MAX_BYTES) {
         error_set(err, "map_size %d: a %d-face map needs %.2f GiB, above the %.0f GiB cap on shadow maps", spec->res,
-                  max_faces(light, spec->projection), (double)bytes / (1 << 30), (double)SHADOWMAP_MAX_BYTES / (1 << 30));
+                  max_faces(light, spec), (double)bytes / (1 << 30), (double)SHADOWMAP_MAX_BYTES / (1 << 30));
+        return NULL;
+    }
+    const char *why = spec->projection == MAP_PROJ_LOGPSM ? logmap_refusal(spec) : NULL;
+    if (spec->projection >= MAP_PROJ_PSM && spec->depth == RASTER_DEPTH_NDC && spec->layer == MAP_LAYER_PEELED)
+        why = "a peeled layer of a warped map needs linear depth (its ndc depth is rescaled per texel)";
+    if (why) {
+        error_set(err, "projection %s: %s", map_projection_name(spec->projection), why);
         return NULL;
     }
     MapArgs a = {rm, scene, light_index, *spec, map_key(scene, light_index, spec)};
-    char desc[160];
-    snprintf(desc, sizeof desc, "light %d, %d^2 %s, fit %s, %s %s, %s%s", light_index + 1, spec->res,
+    char desc[160], parts[24] = "";
+    if (spec->view.cascades > 1) snprintf(parts, sizeof parts, " x%d cascades", spec->view.cascades);
+    snprintf(desc, sizeof desc, "light %d, %d^2%s %s, fit %s, %s %s, %s%s", light_index + 1, spec->res, parts,
              map_projection_name(spec->projection), map_fit_name(spec->fit),
              spec->depth == RASTER_DEPTH_LINEAR ? "linear" : "ndc",
              spec->depth_bits ? (spec->depth_bits == 16 ? "16-bit" : "24-bit") : "f32", layer_name(spec->layer),

@@ -31,6 +31,7 @@ typedef struct ShadowMapSpec {
     RasterCull cull;          /* MAP_LAYER_FIRST only: RASTER_CULL_NONE or _BACK */
     bool triangle_ids;
     bool conservative;
+    LightViewParams view;     /* warps, cascades, stabilisation (lightview.h) */
 } ShadowMapSpec;
 
 typedef struct ShadowMap {
@@ -43,7 +44,9 @@ typedef struct ShadowMap {
     RasterStats stats;
 } ShadowMap;
 
-/* The spec's defaults: 1024^2, auto projection, scene fit, linear float depth, first layer. */
+/* The spec's defaults: 1024^2, auto projection, scene fit, linear float depth,
+ * first layer, one cascade. LogPSM maps are ray cast (logmap.h), the others
+ * rasterized. */
 ShadowMapSpec shadowmap_spec_default(void);
 const ShadowMap *res_shadow_map(ResourceManager *rm, const Scene *scene, int light_index, const ShadowMapSpec *spec,
                                 Error *err);

@@ -6,6 +6,9 @@ const char *const smap_projection_names[] = {MAP_PROJ_NAMES, NULL};
 const char *const smap_fit_names[] = {MAP_FIT_NAMES, NULL};
 const char *const smap_depth_names[] = {"linear", "ndc", NULL};
 const char *const smap_bits_names[] = {"f32", "u24", "u16", NULL};
+const char *const smap_falloff_names[] = {WARP_FALLOFF_NAMES, NULL};
+const char *const smap_split_names[] = {SPLIT_SCHEME_NAMES, NULL};
+const char *const smap_select_names[] = {CASCADE_SELECT_NAMES, NULL};
 
 ShadowMapSpec smap_spec(const double *p)
 {
@@ -16,6 +19,12 @@ ShadowMapSpec smap_spec(const double *p)
     s.fit = (MapFit)(int)p[SMAP_P_FIT];
     s.depth = (int)p[SMAP_P_DEPTH] == 1 ? RASTER_DEPTH_NDC : RASTER_DEPTH_LINEAR;
     s.depth_bits = bits[(int)p[SMAP_P_DEPTH_BITS]];
+    s.view = (LightViewParams){.warp_n = p[SMAP_P_WARP_N], .falloff = (WarpFalloff)(int)p[SMAP_P_WARP_FALLOFF],
+                               .pseudo_near = p[SMAP_P_PSEUDO_NEAR], .tsm_focus = p[SMAP_P_TSM_FOCUS],
+                               .stabilize = p[SMAP_P_STABILIZE] != 0.0, .cascades = (int)p[SMAP_P_CASCADES],
+                               .split = (SplitScheme)(int)p[SMAP_P_SPLIT_SCHEME], .split_lambda = p[SMAP_P_SPLIT_LAMBDA],
+                               .select = (CascadeSelect)(int)p[SMAP_P_CASCADE_SELECT],
+                               .blend = p[SMAP_P_CASCADE_BLEND]};
     return s;
 }
 

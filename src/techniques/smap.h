@@ -16,24 +16,68 @@ extern const char *const smap_projection_names[];
 extern const char *const smap_fit_names[];
 extern const char *const smap_depth_names[];
 extern const char *const smap_bits_names[];
+extern const char *const smap_falloff_names[];
+extern const char *const smap_split_names[];
+extern const char *const smap_select_names[];
 
 #define SMAP_MAP_PARAMS                                                                                            \
     {"map_size", PARAM_INT, 1024, 1, RASTER_MAX_SIZE, "texels",                                                     \
      "shadow-map resolution per side (per face for cube and paraboloid maps)", NULL},                              \
-    {"projection", PARAM_ENUM, 0, 0, 4, "",                                                                          \
+    {"projection", PARAM_ENUM, 0, 0, MAP_PROJ_COUNT - 1, "",                                                         \
      "light projection (course §2.1.1): auto = perspective for spot, rect and disk lights, ortho for directional, " \
-     "perspective or a cube map for point and sphere lights (cube when the scene spans more than 150 degrees)",    \
+     "perspective or a cube map for point and sphere lights (cube when the scene spans more than 150 degrees); "   \
+     "or a warp (course §3.2.2) on the ortho or perspective base: psm (Stamminger & Drettakis), lispsm (Wimmer), " \
+     "tsm (Martin & Tan, 80% rule), logpsm (Lloyd, logarithmic along the view, ray cast per texel)",             \
      smap_projection_names},                                                                                       \
-    {"fit", PARAM_ENUM, 0, 0, 2, "",                                                                                 \
+    {"fit", PARAM_ENUM, 0, 0, MAP_FIT_COUNT - 1, "",                                                                 \
      "what the frustum is fitted to (course §3.2.1): the scene's bounds, the receivers the camera sees (read "     \
-     "exactly from the view samples), or none (a spot's cone, the scene's bounding sphere)",                       \
+     "exactly from the view samples), none (a spot's cone, the scene's bounding sphere), the intersection body B " \
+     "(view frustum inside the scene's bounds), or B with its far plane at the farthest visible sample",           \
      smap_fit_names},                                                                                              \
     {"depth", PARAM_ENUM, 0, 0, 1, "",                                                                               \
      "stored depth: linear (world units along the light's axis) or ndc (post-projective z in [0, 1])",             \
      smap_depth_names},                                                                                            \
     {"depth_bits", PARAM_ENUM, 0, 0, 2, "",                                                                          \
      "depth storage: f32, or u24/u16 quantised over the light's depth range (course §2.1.2 on precision)",         \
-     smap_bits_names}
+     smap_bits_names},                                                                                             \
+    {"warp_n", PARAM_FLOAT, 1, 0.01, 1e6, "x n_opt",                                                                  \
+     "lispsm and logpsm: the warp's n as a multiple of the falloff's n (lispsm: n_opt = z_n + sqrt(z_f z_n) for "  \
+     "a view perpendicular to the light, course §3.2.2.3); small n warps toward PSM, large toward uniform",         \
+     NULL},                                                                                                        \
+    {"warp_falloff", PARAM_ENUM, 0, 0, 2, "",                                                                        \
+     "how the warp relaxes as the view turns toward the light's direction (angle gamma): Lloyd's (thesis "         \
+     "§5.2.1, uniform within theta/3), n_opt / sin(gamma) (Wimmer 2004), or none",                                 \
+     smap_falloff_names},                                                                                          \
+    {"pseudo_near", PARAM_FLOAT, 0, 0, 1e9, "world units",                                                           \
+     "pseudo-near plane (Lloyd 2007 §5.1.8-5.1.9): warps and splits are computed as if the view's near plane "     \
+     "were here (0: off)",                                                                                         \
+     NULL},                                                                                                        \
+    {"tsm_focus", PARAM_FLOAT, 0.5, 0.01, 1, "fraction",                                                              \
+     "tsm: the focus point, as a fraction of the body's view-depth range from its near end; it maps to the 80% "   \
+     "line of the map (Martin & Tan 2004)",                                                                        \
+     NULL},                                                                                                        \
+    {"stabilize", PARAM_BOOL, 0, 0, 1, "",                                                                           \
+     "uniform maps of directional lights: world-fixed orientation and texel-snapped extents on a ladder of "       \
+     "sizes, so texels stay still as the camera moves (course §3.2.1)",                                            \
+     NULL},                                                                                                        \
+    {"cascades", PARAM_INT, 1, 1, LIGHTVIEW_MAX_CASCADES, "maps",                                                    \
+     "z-partitioning (cascaded / parallel-split shadow maps, course §3.2.3.1): this many maps of map_size^2, "      \
+     "each fitted to its slice of the view (fit body, body_visible or view); 1: a single map",                     \
+     NULL},                                                                                                        \
+    {"split_scheme", PARAM_ENUM, 0, 0, 3, "",                                                                        \
+     "split positions: practical (lambda log + (1 - lambda) uniform, Zhang 2006), log (C_i = z_n (z_f/z_n)^(i/m), " \
+     "Lloyd 2006), uniform, or faces (one warped map per light-facing face of the view frustum, course §3.2.3.2)", \
+     smap_split_names},                                                                                            \
+    {"split_lambda", PARAM_FLOAT, 0.5, 0, 1, "",                                                                     \
+     "practical split scheme: weight of the logarithmic positions (0: uniform, 1: log)", NULL},                    \
+    {"cascade_select", PARAM_ENUM, 0, 0, 1, "",                                                                      \
+     "which cascade a point uses: the slice of its view depth, or the nearest cascade whose map contains it "      \
+     "(better with the light near the view axis, Zhang 2009)",                                                     \
+     smap_select_names},                                                                                           \
+    {"cascade_blend", PARAM_FLOAT, 0, 0, 0.5, "fraction",                                                            \
+     "fraction of each slice, at its far end, over which points are dithered into the next cascade (0: hard "      \
+     "borders)",                                                                                                   \
+     NULL}
 
 #define SMAP_BIAS_PARAMS SMAP_BIAS_PARAMS_PLANE(0)
 /* The same with the receiver-plane bias on (1) or off (0) by default: wide
@@ -60,6 +104,8 @@ extern const char *const smap_bits_names[];
 
 enum {
     SMAP_P_MAP_SIZE, SMAP_P_PROJECTION, SMAP_P_FIT, SMAP_P_DEPTH, SMAP_P_DEPTH_BITS,
+    SMAP_P_WARP_N, SMAP_P_WARP_FALLOFF, SMAP_P_PSEUDO_NEAR, SMAP_P_TSM_FOCUS, SMAP_P_STABILIZE,
+    SMAP_P_CASCADES, SMAP_P_SPLIT_SCHEME, SMAP_P_SPLIT_LAMBDA, SMAP_P_CASCADE_SELECT, SMAP_P_CASCADE_BLEND,
     SMAP_P_BIAS, SMAP_P_BIAS_STEPS, SMAP_P_SLOPE_BIAS, SMAP_P_SLOPE_MAX, SMAP_P_NORMAL_OFFSET, SMAP_P_RECEIVER_PLANE,
     SMAP_NUM_PARAMS
 };
@@ -121,7 +167,7 @@ static inline double smap_linear_depth(const ShadowMap *m, int face, double stor
     const MapFace *f = &m->view.face[face];
     if (m->spec.depth == RASTER_DEPTH_LINEAR || !isfinite(stored)) return stored;
     double n = f->raster.depth_near, far = f->raster.depth_far;
-    if (!f->perspective) return n + stored * (far - n);
+    if (!f->perspective && !f->base_perspective) return n + stored * (far - n); /* warps keep the base's z */
     double den = 1.0 - stored * (far - n) / far; /* n/d: reaches 0 only beyond the far plane */
     return den > 0.0 ? n / den : INFINITY;
 }
