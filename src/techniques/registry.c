@@ -8,6 +8,12 @@
 extern const Technique tech_hard;
 extern const Technique tech_sm;
 extern const Technique tech_pcf;
+extern const Technique tech_vsm;
+extern const Technique tech_lvsm;
+extern const Technique tech_evsm;
+extern const Technique tech_msm;
+extern const Technique tech_esm;
+extern const Technique tech_csm;
 extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
 
@@ -15,6 +21,12 @@ static const Technique *const registry[] = {
     &tech_hard,
     &tech_sm,
     &tech_pcf,
+    &tech_vsm,
+    &tech_lvsm,
+    &tech_evsm,
+    &tech_msm,
+    &tech_esm,
+    &tech_csm,
     &tech_adaptive_area,
     &tech_shadow_width,
 };

@@ -1,0 +1,671 @@
+/* prefilter.c -- moment maps, box blurs, summed-area tables and min-max
+ * pyramids derived from a depth map (prefilter.h; course ch.4 and its box
+ * "Fast-box Filter Approximations"). */
+#include "resources/prefilter.h"
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include "core/hash.h"
+
+/* ---- element storage ---- */
+
+static bool store_alloc(PfStore *s, size_t n, bool f64)
+{
+    s->d = f64 ? malloc(n * sizeof *s->d) : NULL;
+    s->f = f64 ? NULL : malloc(n * sizeof *s->f);
+    return s->d || s->f;
+}
+
+static void store_free(PfStore *s)
+{
+    free(s->d);
+    free(s->f);
+}
+
+static inline void pf_put(PfStore *s, size_t i, double v)
+{
+    if (s->d) s->d[i] = v;
+    else s->f[i] = (float)v;
+}
+
+/* v rounded to the element type. A float operation is the double operation
+ * of the same floats rounded once, so this is f32 arithmetic exactly. */
+static inline double pf_round(const PfStore *s, double v) { return s->d ? v : (double)(float)v; }
+
+static size_t elem_bytes(bool f64) { return f64 ? sizeof(double) : sizeof(float); }
+
+static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
+
+static bool check_bytes(const char *what, int res, int faces, int channels, bool f64, size_t bytes, Error *err)
+{
+    if (bytes <= PREFILTER_MAX_BYTES) return true;
+    return error_set(err,
+                     "%s of a %d^2 %d-face map with %d channels in %s needs %.2f GiB, above the %.0f GiB cap "
+                     "(use precision=f32, fewer channels or a smaller map_size)",
+                     what, res, faces, channels, f64 ? "f64" : "f32", (double)bytes / (1 << 30),
+                     (double)PREFILTER_MAX_BYTES / (1 << 30));
+}
+
+/* ---- moment maps ---- */
+
+int moment_channels(const MomentSpec *sp)
+{
+    switch (sp->warp) {
+    case WARP_POWERS: return sp->order;
+    case WARP_LAYERS: return 2 * sp->order;
+    case WARP_EXP: return sp->order;
+    case WARP_FOURIER: return 2 * sp->order;
+    case WARP_LOG_EXP: return 1;
+    }
+    return 0;
+}
+
+double prefilter_depth_unit(const ShadowMap *m, int face, double z)
+{
+    if (!(z < INFINITY)) return 1.0; /* no caster: the far plane */
+    double u = z;
+    if (m->spec.depth == RASTER_DEPTH_LINEAR) {
+        const RasterView *rv = &m->view.face[face].raster;
+        double span = rv->depth_far - rv->depth_near;
+        u = span > 0.0 ? (z - rv->depth_near) / span : 0.0;
+    }
+    return u < 0.0 ? 0.0 : u > 1.0 ? 1.0 : u;
+}
+
+/* The smaller one-sided difference of u along a row or column: the surface's
+ * slope per texel, without jumping across a depth discontinuity. */
+static double slope_per_texel(double prev, double u, double next, bool has_prev, bool has_next)
+{
+    double a = has_prev ? u - prev : INFINITY, b = has_next ? next - u : INFINITY;
+    double d = fabs(a) < fabs(b) ? a : b;
+    return isfinite(d) ? d : 0.0;
+}
+
+void fourier_basis(double u, int terms, double *out)
+{
+    /* The angle c_k u grows by 2 pi u per term: rotate instead of calling sin, cos 2M times. */
+    double s = sin(M_PI * u), c = cos(M_PI * u), ss = sin(2.0 * M_PI * u), cs = cos(2.0 * M_PI * u);
+    for (int k = 0; k < terms; k++) {
+        out[2 * k] = s;
+        out[2 * k + 1] = c;
+        double s2 = s * cs + c * ss;
+        c = c * cs - s * ss;
+        s = s2;
+    }
+}
+
+/* The warped channels of one texel at normalised depth u. */
+static void warp_texel(const MomentSpec *sp, double u, double dx, double dy, double *out)
+{
+    switch (sp->warp) {
+    case WARP_POWERS: {
+        double z = sp->signed_depth ? 2.0 * u - 1.0 : u, p = z;
+        for (int k = 0; k < sp->order; k++, p *= z) out[k] = p;
+        /* Lauritzen 2007 (course §4.2.1 box): a plane over the texel with
+         * E(u^2) = E(v^2) = 1/4 adds (ddx^2 + ddy^2) / 4 to M2. */
+        if (sp->slope_moment && sp->order >= 2) out[1] += 0.25 * (dx * dx + dy * dy);
+        break;
+    }
+    case WARP_LAYERS:
+        /* course §4.2.2: phi_i(x) = 0 below d_i, (x - d_i) / (d_{i+1} - d_i) inside, 1 above; d_i = i / L. */
+        for (int i = 0; i < sp->order; i++) {
+            double phi = (u - (double)i / sp->order) * sp->order;
+            phi = phi < 0.0 ? 0.0 : phi > 1.0 ? 1.0 : phi;
+            out[2 * i] = phi;
+            out[2 * i + 1] = phi * phi;
+        }
+        break;
+    case WARP_EXP: {
+        /* EVSM (course §4.2.4, erratum: the pair is +exp(cz), -exp(-cz)). The
+         * positive warp is scaled by e^-c+ (Chebyshev's bound is invariant
+         * under scaling), so its largest value is 1 and nothing overflows;
+         * the second moments hold e^(2c...) as the catalogue notes. */
+        double a = exp(sp->c_pos * (u - 1.0));
+        out[0] = a;
+        out[1] = a * a;
+        if (sp->order == 4) {
+            double b = exp(-sp->c_neg * u);
+            out[2] = -b;
+            out[3] = b * b;
+        }
+        break;
+    }
+    case WARP_FOURIER: fourier_basis(u, sp->order, out); break;
+    case WARP_LOG_EXP: out[0] = sp->c_pos * u; break; /* ln e^(c u) */
+    }
+}
+
+static void moments_destroy(void *r)
+{
+    MomentMap *mm = r;
+    store_free(&mm->data);
+    free(mm);
+}
+
+static size_t moments_bytes(const void *r)
+{
+    const MomentMap *mm = r;
+    return sizeof *mm + (size_t)mm->num_faces * mm->res * mm->res * mm->channels * elem_bytes(mm->spec.f64);
+}
+
+static const ResourceKind kind_moments = {"moments", moments_bytes, moments_destroy};
+
+typedef struct MomentArgs { const ShadowMap *map; MomentSpec spec; uint64_t key; } MomentArgs;
+
+static void warp_row(const ShadowMap *m, const MomentSpec *sp, MomentMap *mm, int f, int j)
+{
+    int res = m->res, C = mm->channels;
+    double out[PREFILTER_MAX_CHANNELS];
+#define U(i_, j_) prefilter_depth_unit(m, f, shadowmap_texel(m, f, (i_), (j_)))
+    for (int i = 0; i < res; i++) {
+        double u = U(i, j), dx = 0.0, dy = 0.0;
+        if (sp->slope_moment) {
+            dx = slope_per_texel(i > 0 ? U(i - 1, j) : 0, u, i + 1 < res ? U(i + 1, j) : 0, i > 0, i + 1 < res);
+            dy = slope_per_texel(j > 0 ? U(i, j - 1) : 0, u, j + 1 < res ? U(i, j + 1) : 0, j > 0, j + 1 < res);
+        }
+        warp_texel(sp, u, dx, dy, out);
+        size_t base = (((size_t)f * res + j) * res + i) * C;
+        for (int c = 0; c < C; c++) pf_put(&mm->data, base + c, out[c]);
+    }
+#undef U
+}
+
+static void *build_moments(const void *args, Error *err)
+{
+    const MomentArgs *a = args;
+    MomentMap *mm = calloc(1, sizeof *mm);
+    if (!mm) { error_set(err, "out of memory"); return NULL; }
+    *mm = (MomentMap){a->key, a->map, a->spec, a->map->res, a->map->num_faces, moment_channels(&a->spec),
+                      a->spec.warp == WARP_LOG_EXP, {NULL, NULL}};
+    size_t n = (size_t)mm->num_faces * mm->res * mm->res * mm->channels;
+    if (!store_alloc(&mm->data, n, a->spec.f64)) {
+        error_set(err, "out of memory for a %d-channel %d^2 moment map", mm->channels, mm->res);
+        free(mm);
+        return NULL;
+    }
+    int rows = mm->num_faces * mm->res;
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < rows; r++) warp_row(a->map, &a->spec, mm, r / mm->res, r % mm->res);
+    return mm;
+}
+
+static const char *warp_name(MomentWarp w)
+{
+    static const char *const names[] = {"powers", "layers", "exp", "fourier", "log-exp"};
+    return names[w];
+}
+
+/* Only the fields the warp reads, so unrelated parameters share one map. */
+static MomentSpec normalised_spec(const MomentSpec *in)
+{
+    MomentSpec s = {.warp = in->warp, .order = in->order, .f64 = in->f64};
+    if (in->warp == WARP_EXP || in->warp == WARP_LOG_EXP) s.c_pos = in->c_pos;
+    if (in->warp == WARP_EXP && in->order == 4) s.c_neg = in->c_neg;
+    if (in->warp == WARP_POWERS) {
+        s.signed_depth = in->signed_depth;
+        s.slope_moment = in->slope_moment && in->order >= 2;
+    }
+    if (in->warp == WARP_LOG_EXP) s.order = 1;
+    return s;
+}
+
+const MomentMap *res_moment_map(ResourceManager *rm, const ShadowMap *map, const MomentSpec *spec_in, Error *err)
+{
+    MomentSpec spec = normalised_spec(spec_in);
+    int C = moment_channels(&spec);
+    if (C < 1 || C > PREFILTER_MAX_CHANNELS)
+        return error_set(err, "a moment map needs 1 to %d channels, not %d", PREFILTER_MAX_CHANNELS, C), NULL;
+    size_t bytes = (size_t)map->num_faces * map->res * map->res * C * elem_bytes(spec.f64);
+    if (!check_bytes("the moment map", map->res, map->num_faces, C, spec.f64, bytes, err)) return NULL;
+    Hasher h;
+    hash_init(&h);
+    hash_u64(&h, map->key);
+    hash_str(&h, "moments");
+    const int64_t fields[] = {spec.warp, spec.order, spec.signed_depth, spec.slope_moment, spec.f64};
+    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) hash_u64(&h, (uint64_t)fields[i]);
+    hash_f64(&h, spec.c_pos);
+    hash_f64(&h, spec.c_neg);
+    MomentArgs a = {map, spec, hash_final(&h)};
+    char desc[160], mk[17];
+    hash_hex(map->key, mk);
+    snprintf(desc, sizeof desc, "%s x%d (%d ch, %s%s) c %g/%g of map %s", warp_name(spec.warp), spec.order, C,
+             spec.f64 ? "f64" : "f32", spec.slope_moment ? ", slope moment" : "", spec.c_pos, spec.c_neg, mk);
+    return rm_acquire(rm, &kind_moments, a.key, desc, build_moments, &a, err);
+}
+
+/* ---- box blurs and summed-area tables ---- */
+
+static void prefiltered_destroy(void *r)
+{
+    Prefiltered *pf = r;
+    store_free(&pf->data);
+    free(pf->offset);
+    free(pf);
+}
+
+static size_t prefiltered_entries(const Prefiltered *pf)
+{
+    size_t side = (size_t)pf->stride + (pf->kind == PREFILTER_SAT);
+    return (size_t)pf->num_faces * side * side * pf->channels;
+}
+
+static size_t prefiltered_bytes(const void *r)
+{
+    const Prefiltered *pf = r;
+    return sizeof *pf + prefiltered_entries(pf) * elem_bytes(pf->f64) +
+           (size_t)pf->num_faces * pf->channels * sizeof(double);
+}
+
+static const ResourceKind kind_box = {"box_blur", prefiltered_bytes, prefiltered_destroy};
+static const ResourceKind kind_sat = {"sat", prefiltered_bytes, prefiltered_destroy};
+
+typedef struct PrefilterArgs { const MomentMap *mm; PrefilterKind kind; int K; uint64_t key; } PrefilterArgs;
+
+/* Channels a box blur's intermediate holds at once (its memory: res x stride x this). */
+#define BOX_CHUNK 8
+
+/* For each of nc interleaved channels, out[o] = mean of in[clamp(o - shift
+ * + k)], k = 0..K-1 (edge replicated); for log values, the log of the mean
+ * of their exponentials, shifted by the window's max so no exponential
+ * overflows (catalogue §4.2.4 [LIT]: ln sum w e^x = x0 + ln sum w e^(x - x0)). */
+static void box_line(const double *in, int n_in, double *out, int n_out, int nc, int K, int shift, bool log_values)
+{
+#define IN(k_) in[(size_t)clampi((k_), 0, n_in - 1) * nc + c]
+    for (int c = 0; c < nc; c++) {
+        if (log_values) {
+            for (int o = 0; o < n_out; o++) {
+                double m = -INFINITY, sum = 0.0;
+                for (int k = 0; k < K; k++) m = fmax(m, IN(o - shift + k));
+                for (int k = 0; k < K; k++) sum += exp(IN(o - shift + k) - m);
+                out[(size_t)o * nc + c] = m + log(sum / K);
+            }
+            continue;
+        }
+        /* A running sum, recomputed whenever the value leaving the window
+         * was 256 times larger than what remains: subtracting it would leave
+         * its rounding error in every later window (exponential warps span
+         * e^-c, and a residual 1e-16 of a far texel's 1 swamps e^-40). */
+        double sum = 0.0;
+        for (int k = 0; k < K; k++) sum += IN(k - shift);
+        for (int o = 0; o < n_out; o++) {
+            out[(size_t)o * nc + c] = sum / K;
+            double leaving = IN(o - shift);
+            sum += IN(o - shift + K) - leaving;
+            if (fabs(leaving) > 256.0 * fabs(sum)) {
+                sum = 0.0;
+                for (int k = 1; k <= K; k++) sum += IN(o - shift + k);
+            }
+        }
+    }
+#undef IN
+}
+
+/* Separable K x K box of channels [c0, c0 + nc) of one face: the moment
+ * map's rows into `tmp` (res rows x stride), then its columns into the
+ * padded output. false when a thread's line buffers cannot be allocated. */
+static bool box_channels(Prefiltered *pf, int f, int c0, int nc, double *tmp)
+{
+    const MomentMap *mm = pf->moments;
+    int res = pf->res, S = pf->stride, C = pf->channels, shift = pf->pad + pf->K / 2;
+    bool ok = true;
+#pragma omp parallel
+    {
+        double *in = malloc(sizeof *in * (size_t)res * nc), *out = malloc(sizeof *out * (size_t)S * nc);
+        if (!in || !out) {
+#pragma omp atomic write
+            ok = false;
+        }
+#pragma omp for schedule(static)
+        for (int j = 0; j < res; j++) {
+            if (!in || !out) continue;
+            for (int i = 0; i < res; i++)
+                for (int c = 0; c < nc; c++)
+                    in[(size_t)i * nc + c] = pf_get(&mm->data, (((size_t)f * res + j) * res + i) * C + c0 + c);
+            box_line(in, res, tmp + (size_t)j * S * nc, S, nc, pf->K, shift, pf->log);
+        }
+#pragma omp for schedule(static)
+        for (int I = 0; I < S; I++) {
+            if (!in || !out) continue;
+            for (int j = 0; j < res; j++)
+                for (int c = 0; c < nc; c++) in[(size_t)j * nc + c] = tmp[((size_t)j * S + I) * nc + c];
+            box_line(in, res, out, S, nc, pf->K, shift, pf->log);
+            for (int J = 0; J < S; J++)
+                for (int c = 0; c < nc; c++)
+                    pf_put(&pf->data, (((size_t)f * S + J) * S + I) * C + c0 + c, out[(size_t)J * nc + c]);
+        }
+        free(in);
+        free(out);
+    }
+    return ok;
+}
+
+/* What a SAT subtracts from each channel before summing: its mean over
+ * the face (catalogue [OWN]: keeps the sums small), or for log channels
+ * the largest value (the sum is then of e^(x - x_max) <= 1). */
+static void sat_offsets(const MomentMap *mm, int f, double *off)
+{
+    size_t n = (size_t)mm->res * mm->res, C = (size_t)mm->channels, base = (size_t)f * n * C;
+    for (size_t c = 0; c < C; c++) off[c] = mm->log ? -INFINITY : 0.0;
+    for (size_t k = 0; k < n; k++)
+        for (size_t c = 0; c < C; c++) {
+            double v = pf_get(&mm->data, base + k * C + c);
+            off[c] = mm->log ? fmax(off[c], v) : off[c] + v;
+        }
+    if (!mm->log)
+        for (size_t c = 0; c < C; c++) off[c] /= (double)n;
+}
+
+/* SAT entry (I, J) = sum over padded texels [0, I) x [0, J), every channel,
+ * in the element type's arithmetic: row prefix sums, then the columns. */
+static void sat_face(Prefiltered *pf, int f)
+{
+    const MomentMap *mm = pf->moments;
+    int res = pf->res, E = pf->stride + 1, C = pf->channels, pad = pf->pad;
+    const double *off = pf->offset + (size_t)f * C;
+    size_t face0 = (size_t)f * E * E * C, row = (size_t)E * C;
+    for (size_t x = 0; x < row; x++) pf_put(&pf->data, face0 + x, 0.0);
+#pragma omp parallel for schedule(static)
+    for (int J = 1; J < E; J++) {
+        int j = clampi(J - 1 - pad, 0, res - 1);
+        double r[PREFILTER_MAX_CHANNELS] = {0};
+        size_t at = face0 + (size_t)J * row;
+        for (int c = 0; c < C; c++) pf_put(&pf->data, at + c, 0.0);
+        for (int I = 1; I < E; I++) {
+            size_t src = (((size_t)f * res + j) * res + clampi(I - 1 - pad, 0, res - 1)) * C;
+            for (int c = 0; c < C; c++) {
+                double v = pf_get(&mm->data, src + c);
+                r[c] = pf_round(&pf->data, r[c] + (pf->log ? exp(v - off[c]) : pf_round(&pf->data, v - off[c])));
+                pf_put(&pf->data, at + (size_t)I * C + c, r[c]);
+            }
+        }
+    }
+    const size_t block = 512;
+#pragma omp parallel for schedule(static)
+    for (size_t b = 0; b < row; b += block)
+        for (int J = 2; J < E; J++) {
+            size_t at = face0 + (size_t)J * row;
+            for (size_t x = b; x < b + block && x < row; x++)
+                pf_put(&pf->data, at + x, pf_get(&pf->data, at - row + x) + pf_get(&pf->data, at + x));
+        }
+}
+
+static void *build_prefiltered(const void *args, Error *err)
+{
+    const PrefilterArgs *a = args;
+    const MomentMap *mm = a->mm;
+    Prefiltered *pf = calloc(1, sizeof *pf);
+    if (!pf) { error_set(err, "out of memory"); return NULL; }
+    *pf = (Prefiltered){.key = a->key, .moments = mm, .kind = a->kind, .K = a->kind == PREFILTER_BOX ? a->K : 0,
+                        .res = mm->res, .pad = PREFILTER_PAD, .stride = mm->res + 2 * PREFILTER_PAD,
+                        .num_faces = mm->num_faces, .channels = mm->channels, .log = mm->log, .f64 = mm->spec.f64};
+    /* A log SAT's corners sum at most stride^2 positive terms through 2
+     * stride roundings each; the window's four corners then err by at most
+     * 8 stride eps times the largest (first-order bound, Higham §4.2). */
+    pf->sat_rel_error = 8.0 * pf->stride * (pf->f64 ? DBL_EPSILON : FLT_EPSILON) / 2.0;
+    pf->offset = calloc((size_t)pf->num_faces * pf->channels, sizeof *pf->offset);
+    double *tmp = a->kind == PREFILTER_BOX ? malloc(sizeof *tmp * (size_t)pf->res * pf->stride * BOX_CHUNK) : NULL;
+    if (!pf->offset || (a->kind == PREFILTER_BOX && !tmp) || !store_alloc(&pf->data, prefiltered_entries(pf), pf->f64)) {
+        error_set(err, "out of memory for a %d-channel %d^2 %s", pf->channels, pf->res,
+                  a->kind == PREFILTER_BOX ? "box blur" : "summed-area table");
+        free(tmp);
+        prefiltered_destroy(pf);
+        return NULL;
+    }
+    bool ok = true;
+    for (int f = 0; ok && f < pf->num_faces; f++) {
+        if (a->kind == PREFILTER_SAT) {
+            sat_offsets(mm, f, pf->offset + (size_t)f * pf->channels);
+            sat_face(pf, f);
+            continue;
+        }
+        for (int c0 = 0; ok && c0 < pf->channels; c0 += BOX_CHUNK)
+            ok = box_channels(pf, f, c0, pf->channels - c0 < BOX_CHUNK ? pf->channels - c0 : BOX_CHUNK, tmp);
+    }
+    free(tmp);
+    if (!ok) {
+        prefiltered_destroy(pf);
+        error_set(err, "out of memory for the box blur's line buffers");
+        return NULL;
+    }
+    return pf;
+}
+
+const Prefiltered *res_prefiltered(ResourceManager *rm, const MomentMap *mm, PrefilterKind kind, int K, Error *err)
+{
+    if (K < 1 || K > PREFILTER_MAX_K) return error_set(err, "filter width K = %d outside [1, %d]", K, PREFILTER_MAX_K), NULL;
+    size_t side = (size_t)mm->res + 2 * PREFILTER_PAD + (kind == PREFILTER_SAT);
+    size_t bytes = (size_t)mm->num_faces * side * side * mm->channels * elem_bytes(mm->spec.f64);
+    if (!check_bytes(kind == PREFILTER_SAT ? "the summed-area table" : "the box blur", mm->res, mm->num_faces,
+                     mm->channels, mm->spec.f64, bytes, err))
+        return NULL;
+    Hasher h;
+    hash_init(&h);
+    hash_u64(&h, mm->key);
+    hash_str(&h, kind == PREFILTER_SAT ? "sat" : "box");
+    if (kind == PREFILTER_BOX) hash_u64(&h, (uint64_t)K);
+    PrefilterArgs a = {mm, kind, K, hash_final(&h)};
+    char desc[160], mk[17];
+    hash_hex(mm->key, mk);
+    if (kind == PREFILTER_SAT)
+        snprintf(desc, sizeof desc, "summed-area table (%d ch, %s) of moments %s", mm->channels,
+                 mm->spec.f64 ? "f64" : "f32", mk);
+    else
+        snprintf(desc, sizeof desc, "%dx%d box blur (%d ch, %s) of moments %s", K, K, mm->channels,
+                 mm->spec.f64 ? "f64" : "f32", mk);
+    return rm_acquire(rm, kind == PREFILTER_SAT ? &kind_sat : &kind_box, a.key, desc, build_prefiltered, &a, err);
+}
+
+/* ---- lookups ---- */
+
+PfFootprint pf_footprint(double s, double t, int K, bool bilinear)
+{
+    PfFootprint fp = {.K = K, .bilinear = bilinear};
+    if (!bilinear) {
+        fp.i0 = (int)floor(s - 0.5 * K + 0.5);
+        fp.j0 = (int)floor(t - 0.5 * K + 0.5);
+        return fp;
+    }
+    double fs = s - 0.5 * K, ft = t - 0.5 * K;
+    fp.i0 = (int)floor(fs);
+    fp.j0 = (int)floor(ft);
+    fp.ax = fs - fp.i0;
+    fp.ay = ft - fp.j0;
+    return fp;
+}
+
+/* Combine up to four per-window averages v[b][a] with weights w (log
+ * channels: in the exponential domain, shifted by their max). */
+static double combine(double v[2][2], double w[2][2], bool log_values)
+{
+    if (!log_values) return w[0][0] * v[0][0] + w[0][1] * v[0][1] + w[1][0] * v[1][0] + w[1][1] * v[1][1];
+    double m = -INFINITY, sum = 0.0;
+    for (int b = 0; b < 2; b++)
+        for (int a = 0; a < 2; a++)
+            if (w[b][a] > 0.0) m = fmax(m, v[b][a]);
+    for (int b = 0; b < 2; b++)
+        for (int a = 0; a < 2; a++)
+            if (w[b][a] > 0.0) sum += w[b][a] * exp(v[b][a] - m);
+    return m + log(sum);
+}
+
+static void footprint_weights(const PfFootprint *fp, double w[2][2])
+{
+    double wx[2] = {1.0 - fp->ax, fp->ax}, wy[2] = {1.0 - fp->ay, fp->ay};
+    for (int b = 0; b < 2; b++)
+        for (int a = 0; a < 2; a++) w[b][a] = wy[b] * wx[a];
+}
+
+static void fetch_box(const Prefiltered *pf, int face, const PfFootprint *fp, double w[2][2], double *out)
+{
+    int S = pf->stride, C = pf->channels, half = pf->K / 2;
+    size_t at[2][2];
+    for (int b = 0; b < 2; b++)
+        for (int a = 0; a < 2; a++) {
+            int I = clampi(fp->i0 + a + half + pf->pad, 0, S - 1), J = clampi(fp->j0 + b + half + pf->pad, 0, S - 1);
+            at[b][a] = (((size_t)face * S + J) * S + I) * C;
+        }
+    for (int c = 0; c < C; c++) {
+        double v[2][2];
+        for (int b = 0; b < 2; b++)
+            for (int a = 0; a < 2; a++) v[b][a] = w[b][a] > 0.0 ? pf_get(&pf->data, at[b][a] + c) : 0.0;
+        out[c] = combine(v, w, pf->log);
+    }
+}
+
+/* Window sums from a SAT's 16 (or 4) corners; false where a log channel's
+ * sum is within its rounding error. */
+static bool fetch_sat(const Prefiltered *pf, int face, const PfFootprint *fp, double w[2][2], double *out)
+{
+    int E = pf->stride + 1, C = pf->channels, K = fp->K;
+    int X[4], Y[4];
+    for (int k = 0; k < 4; k++) {
+        int d = (k & 1) + (k >> 1) * K; /* 0, 1, K, K + 1 */
+        X[k] = clampi(fp->i0 + pf->pad + d, 0, E - 1);
+        Y[k] = clampi(fp->j0 + pf->pad + d, 0, E - 1);
+    }
+    size_t face0 = (size_t)face * E * E;
+    double area = (double)K * K;
+    bool reliable = true;
+    for (int c = 0; c < C; c++) {
+        double v[2][2], off = pf->offset[face * C + c];
+#define S_(x, y) pf_get(&pf->data, (face0 + (size_t)Y[y] * E + X[x]) * C + c)
+        for (int b = 0; b < 2; b++)
+            for (int a = 0; a < 2; a++) {
+                if (!(w[b][a] > 0.0)) { v[b][a] = 0.0; continue; }
+                double hi = S_(a + 2, b + 2), sum = hi - S_(a, b + 2) - S_(a + 2, b) + S_(a, b);
+                if (pf->log && !(sum > pf->sat_rel_error * hi)) reliable = false;
+                v[b][a] = sum / area;
+            }
+#undef S_
+        if (!pf->log) {
+            out[c] = combine(v, w, false) + off;
+            continue;
+        }
+        double mean = combine(v, w, false);
+        out[c] = (mean > 0.0 ? log(mean) : log(DBL_TRUE_MIN)) + off; /* finite even when nothing is left */
+    }
+    return reliable;
+}
+
+bool pf_fetch(const Prefiltered *pf, int face, const PfFootprint *fp, double *out)
+{
+    double w[2][2];
+    footprint_weights(fp, w);
+    if (pf->kind == PREFILTER_BOX) {
+        fetch_box(pf, face, fp, w, out);
+        return true;
+    }
+    return fetch_sat(pf, face, fp, w, out);
+}
+
+/* ---- min-max pyramid ---- */
+
+static void pyramid_destroy(void *r)
+{
+    MinMaxPyramid *p = r;
+    free(p->minmax);
+    free(p);
+}
+
+static size_t pyramid_pairs(const MinMaxPyramid *p)
+{
+    return p->offset[p->levels - 1] + (size_t)p->num_faces * p->size[p->levels - 1] * p->size[p->levels - 1];
+}
+
+static size_t pyramid_bytes(const void *r)
+{
+    const MinMaxPyramid *p = r;
+    return sizeof *p + pyramid_pairs(p) * 2 * sizeof(float);
+}
+
+static const ResourceKind kind_pyramid = {"minmax_pyramid", pyramid_bytes, pyramid_destroy};
+
+typedef struct PyramidArgs { const ShadowMap *map; uint64_t key; } PyramidArgs;
+
+static inline float *node(const MinMaxPyramid *p, int level, int face, int i, int j)
+{
+    int n = p->size[level];
+    return p->minmax + 2 * (p->offset[level] + ((size_t)face * n + j) * n + i);
+}
+
+static void *build_pyramid(const void *args, Error *err)
+{
+    const PyramidArgs *a = args;
+    const ShadowMap *m = a->map;
+    MinMaxPyramid *p = calloc(1, sizeof *p);
+    if (!p) { error_set(err, "out of memory"); return NULL; }
+    p->key = a->key;
+    p->res = m->res;
+    p->num_faces = m->num_faces;
+    for (int n = m->res;; n = (n + 1) / 2) {
+        p->size[p->levels] = n;
+        p->offset[p->levels] = p->levels ? p->offset[p->levels - 1] + (size_t)p->num_faces * p->size[p->levels - 1] *
+                                                                            p->size[p->levels - 1]
+                                         : 0;
+        p->levels++;
+        if (n == 1) break;
+    }
+    p->minmax = malloc(pyramid_pairs(p) * 2 * sizeof *p->minmax);
+    if (!p->minmax) {
+        free(p);
+        error_set(err, "out of memory for a %d^2 min-max pyramid", m->res);
+        return NULL;
+    }
+    for (int f = 0; f < p->num_faces; f++)
+        for (int j = 0; j < m->res; j++)
+            for (int i = 0; i < m->res; i++) {
+                float *q = node(p, 0, f, i, j);
+                q[0] = q[1] = shadowmap_texel(m, f, i, j);
+            }
+    for (int l = 1; l < p->levels; l++) {
+        int n = p->size[l], below = p->size[l - 1];
+        for (int f = 0; f < p->num_faces; f++)
+            for (int j = 0; j < n; j++)
+                for (int i = 0; i < n; i++) {
+                    float lo = INFINITY, hi = -INFINITY;
+                    for (int b = 0; b < 2; b++)
+                        for (int c = 0; c < 2; c++) {
+                            const float *q = node(p, l - 1, f, clampi(2 * i + c, 0, below - 1), clampi(2 * j + b, 0, below - 1));
+                            lo = fminf(lo, q[0]);
+                            hi = fmaxf(hi, q[1]);
+                        }
+                    float *q = node(p, l, f, i, j);
+                    q[0] = lo;
+                    q[1] = hi;
+                }
+    }
+    return p;
+}
+
+const MinMaxPyramid *res_minmax_pyramid(ResourceManager *rm, const ShadowMap *map, Error *err)
+{
+    Hasher h;
+    hash_init(&h);
+    hash_u64(&h, map->key);
+    hash_str(&h, "minmax");
+    PyramidArgs a = {map, hash_final(&h)};
+    char desc[160], mk[17];
+    hash_hex(map->key, mk);
+    snprintf(desc, sizeof desc, "min-max pyramid of map %s", mk);
+    return rm_acquire(rm, &kind_pyramid, a.key, desc, build_pyramid, &a, err);
+}
+
+void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax)
+{
+    i0 = clampi(i0, 0, p->res - 1);
+    i1 = clampi(i1, 0, p->res - 1);
+    j0 = clampi(j0, 0, p->res - 1);
+    j1 = clampi(j1, 0, p->res - 1);
+    int l = 0;
+    while (l + 1 < p->levels && ((i1 >> l) - (i0 >> l) > 1 || (j1 >> l) - (j0 >> l) > 1)) l++;
+    float lo = INFINITY, hi = -INFINITY;
+    for (int j = j0 >> l; j <= j1 >> l; j++)
+        for (int i = i0 >> l; i <= i1 >> l; i++) {
+            const float *q = node(p, l, face, i, j);
+            lo = fminf(lo, q[0]);
+            hi = fmaxf(hi, q[1]);
+        }
+    *zmin = lo;
+    *zmax = hi;
+}

@@ -1,0 +1,131 @@
+/* prefilter.h -- what filtered shadow maps (course ch.4) build from a depth
+ * map, each a keyed resource derived from the ShadowMap's key: moment maps
+ * (per-texel warps of the depth: powers, layers, exponentials, Fourier
+ * bases, or a log-exponential channel for ESM), their prefiltered forms (a
+ * separable K x K box blur, or a summed-area table that serves every K), and
+ * a min-max mip pyramid of the depth (ESM's classifier, §4.2.4). So a sweep
+ * over K builds one moment map and one SAT; a box blur is keyed by K.
+ *
+ * Depth is normalised per face, u = (z - near) / (far - near) in [0, 1]
+ * (linear maps; ndc maps store u = z_ndc), the course's convention for
+ * ch.4 (CSM depths in [0, 1], ESM's c = 80); empty texels (+INFINITY) are
+ * the far plane, u = 1, before any moment is formed.
+ *
+ * Precision (f64 or f32) is the element type of the moment map and of the
+ * prefiltered map, and the arithmetic of a SAT's running sums: an f32 SAT
+ * rounds every partial sum to float, as a GPU would (catalogue, Prefilter
+ * structures: "never use an fp32 SAT"). Box blurs sum in double and store
+ * the result in the element type. SAT channels have their face mean
+ * subtracted (catalogue [OWN]); log channels (ESM) are summed as
+ * e^(x - x_max) with x_max the face's largest value, so nothing overflows. */
+#ifndef SL_PREFILTER_H
+#define SL_PREFILTER_H
+#include "resources/shadowmap.h"
+
+#define PREFILTER_MAX_K 63         /* the widest window, texels (pcf's K) */
+#define PREFILTER_PAD (PREFILTER_MAX_K / 2 + 3) /* texels of edge replication around each face */
+#define PREFILTER_MAX_CHANNELS 64  /* CSM with 32 terms */
+#define PREFILTER_MAX_BYTES ((size_t)2 << 30)
+
+typedef enum MomentWarp {
+    WARP_POWERS,   /* u, u^2, ... u^order (VSM: 2); with `signed_depth` powers of z = 2u - 1 (MSM: 4) */
+    WARP_LAYERS,   /* LVSM (§4.2.2): per layer i of `order` uniform layers, phi_i(u) and phi_i(u)^2 */
+    WARP_EXP,      /* EVSM: e^(c+ (u - 1)), e^(2 c+ (u - 1)) [, -e^(-c- u), e^(-2 c- u)] (order 2 or 4) */
+    WARP_FOURIER,  /* CSM (§4.2.3, Eq. 4.6): sin(c_k u), cos(c_k u), c_k = pi (2k - 1), k = 1..order */
+    WARP_LOG_EXP,  /* ESM (§4.2.4): the log of exp(c u), i.e. c u: a log channel, filtered as log-sum-exp */
+} MomentWarp;
+
+typedef struct MomentSpec {
+    MomentWarp warp;
+    int order;            /* see MomentWarp */
+    double c_pos, c_neg;  /* exponents (EVSM c+ and c-; ESM's c is c_pos) */
+    bool signed_depth;    /* WARP_POWERS: powers of 2u - 1 */
+    bool slope_moment;    /* WARP_POWERS, order 2: M2 += (dx^2 + dy^2) / 4 (Lauritzen 2007, §4.2.1 box) */
+    bool f64;             /* element type: double, else float */
+} MomentSpec;
+
+/* Element storage: exactly one of d, f is non-NULL. */
+typedef struct PfStore { double *d; float *f; } PfStore;
+
+static inline double pf_get(const PfStore *s, size_t i) { return s->d ? s->d[i] : (double)s->f[i]; }
+
+typedef struct MomentMap {
+    uint64_t key;
+    const ShadowMap *map;
+    MomentSpec spec;
+    int res, num_faces, channels;
+    bool log;             /* channels hold logarithms (WARP_LOG_EXP) */
+    PfStore data;         /* [(face * res + j) * res + i] * channels + c */
+} MomentMap;
+
+int moment_channels(const MomentSpec *spec);
+/* CSM's basis at depth u: out[2k] = sin(c_k u), out[2k + 1] = cos(c_k u),
+ * c_k = pi (2k + 1) for k = 0..terms-1 (course Eq. 4.6, k counted from 1 there). */
+void fourier_basis(double u, int terms, double *out);
+/* Normalised depth u in [0, 1] of a stored depth on a face (+INFINITY: 1). */
+double prefilter_depth_unit(const ShadowMap *m, int face, double z_stored);
+const MomentMap *res_moment_map(ResourceManager *rm, const ShadowMap *map, const MomentSpec *spec, Error *err);
+
+typedef enum PrefilterKind { PREFILTER_BOX, PREFILTER_SAT } PrefilterKind;
+#define PREFILTER_NAMES "box", "sat"
+
+/* A prefiltered moment map in a padded layout: face texel (i, j) is at
+ * (i + pad, j + pad) of a stride x stride grid, the border replicating the
+ * edge texels as pcf's clamped lookups do. BOX: texel c holds the average
+ * over the K texels starting at c - K/2 (per axis); SAT: (stride + 1)^2
+ * running sums, entry (I, J) the sum over padded texels [0, I) x [0, J). */
+typedef struct Prefiltered {
+    uint64_t key;
+    const MomentMap *moments;
+    PrefilterKind kind;
+    int K;                /* BOX only; 0 for SAT */
+    int res, pad, stride, num_faces, channels;
+    bool log, f64;
+    double *offset;       /* [face * channels + c]: the mean subtracted (SAT) or x_max (log SAT); else 0 */
+    double sat_rel_error; /* log SAT: a window sum below this times its largest corner is rounding noise */
+    PfStore data;
+} Prefiltered;
+
+const Prefiltered *res_prefiltered(ResourceManager *rm, const MomentMap *moments, PrefilterKind kind, int K,
+                                   Error *err);
+
+/* The texels a lookup at map coordinates (s, t) averages, matching pcf's
+ * kernels of the same K: nearest, the K x K box starting at (i0, j0) =
+ * floor((s, t) - K/2 + 1/2); bilinear, hardware 2x2 taps over K x K, i.e.
+ * boxes starting at i0 and i0 + 1 (and j0, j0 + 1) weighted (1 - ax, ax). */
+typedef struct PfFootprint {
+    int K, i0, j0;
+    double ax, ay;        /* 0 for nearest */
+    bool bilinear;
+} PfFootprint;
+
+PfFootprint pf_footprint(double s, double t, int K, bool bilinear);
+/* Weight of texel i0 + k (k = 0..K, the last only when bilinear) along one axis. */
+static inline double pf_weight(const PfFootprint *fp, int k, double a)
+{
+    if (!fp->bilinear) return k < fp->K ? 1.0 : 0.0;
+    return k == 0 ? 1.0 - a : k == fp->K ? a : 1.0;
+}
+
+/* The footprint's weighted average of every channel into out[channels]
+ * (log channels: the log of the average of their exponentials). false when
+ * a log SAT's window sum is below its rounding error (ESM falls back to
+ * PCF there); the values are then still finite. */
+bool pf_fetch(const Prefiltered *pf, int face, const PfFootprint *fp, double *out);
+
+/* Min and max of the stored depth over mip levels (+INFINITY kept): the
+ * window max for ESM's conservative classifier, the min for a lit early-out. */
+typedef struct MinMaxPyramid {
+    uint64_t key;
+    int res, num_faces, levels;
+    int size[32];         /* texels per side at each level */
+    size_t offset[32];    /* start of each level (per face: faces * size^2 pairs) */
+    float *minmax;        /* pairs (min, max) */
+} MinMaxPyramid;
+
+const MinMaxPyramid *res_minmax_pyramid(ResourceManager *rm, const ShadowMap *map, Error *err);
+/* Conservative bounds of the stored depth over texels [i0, i1] x [j0, j1]
+ * (clamped to the face: the same texels as an edge-clamped window). */
+void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax);
+
+#endif

@@ -1,0 +1,81 @@
+/* filtered.h -- what the prefiltered shadow-map techniques of course ch.4
+ * (vsm, lvsm, evsm, msm in vsm.c; esm.c; csm.c) share: the filter's
+ * parameters, declared once and expanded after SMAP_MAP_PARAMS and
+ * SMAP_BIAS_PARAMS; the chain of keyed resources depth map -> moment map ->
+ * box blur or SAT (resources/prefilter.h); and the lookup of a view sample:
+ * its normalised reference depth and the window's filtered moments.
+ *
+ * The reference depth is the lead's biased smap_receiver depth at the
+ * sample; per-texel receiver-plane depths exist only where a technique tests
+ * texels one by one (ESM's PCF fallback). */
+#ifndef SL_FILTERED_H
+#define SL_FILTERED_H
+#include "resources/prefilter.h"
+#include "techniques/smap.h"
+
+extern const char *const filter_prefilter_names[];
+extern const char *const filter_lookup_names[];
+extern const char *const filter_precision_names[];
+extern const char *const filter_resources[];
+
+enum { FILTER_LOOKUP_NEAREST, FILTER_LOOKUP_BILINEAR };
+
+#define FILTER_PARAMS(prefilter_default)                                                                          \
+    {"K", PARAM_INT, 5, 1, PREFILTER_MAX_K, "texels",                                                               \
+     "filter width: the window covers K x K texels, the same texels as pcf's box (lookup=nearest) or pcf's "       \
+     "bilinear kernel (lookup=bilinear) of the same K",                                                            \
+     NULL},                                                                                                        \
+    {"prefilter", PARAM_ENUM, prefilter_default, 0, 1, "",                                                          \
+     "box: a separable K x K blur, one per K; sat: one summed-area table for every K (course ch.4 box "            \
+     "'Fast-box Filter Approximations': four lookups per window)",                                                 \
+     filter_prefilter_names},                                                                                      \
+    {"lookup", PARAM_ENUM, FILTER_LOOKUP_BILINEAR, 0, 1, "",                                                        \
+     "nearest: the K x K window at the sample's texel; bilinear: hardware-style 2x2 taps of the prefiltered "      \
+     "map, (K+1)^2 texels with a tent rim",                                                                        \
+     filter_lookup_names},                                                                                         \
+    {"precision", PARAM_ENUM, 0, 0, 1, "",                                                                          \
+     "moments and prefiltered sums in f64, or in f32 (a SAT's partial sums rounded to float, as on a GPU; "        \
+     "catalogue: an fp32 SAT destroys moment differences)",                                                        \
+     filter_precision_names}
+
+enum { FILTER_P_K = SMAP_NUM_PARAMS, FILTER_P_PREFILTER, FILTER_P_LOOKUP, FILTER_P_PRECISION, FILTER_NUM_PARAMS };
+
+/* A technique's parameter table fits the registry's limit (the shared map
+ * parameters grow as the lead adds remedies). */
+#define FILTER_CHECK_TABLE(table) \
+    _Static_assert(sizeof table / sizeof table[0] <= TECH_MAX_PARAMS, #table ": more than TECH_MAX_PARAMS")
+
+typedef struct FilteredMaps {
+    const ShadowMap *map;
+    const Prefiltered *pf;
+    SmapBias bias;
+    int K;
+    bool bilinear;
+} FilteredMaps;
+
+/* Acquire the depth map, the moment map of `spec` (its precision taken
+ * from the parameters) and its prefiltered form. */
+bool filtered_acquire(const TechContext *ctx, MomentSpec spec, FilteredMaps *fm, Error *err);
+
+/* A view sample seen through the filtered map. */
+typedef struct FilteredSample {
+    SmapReceiver r;
+    PfFootprint fp;
+    double u;                        /* normalised reference depth, [0, 1] */
+    bool reliable;                   /* false: a log SAT's window is below its rounding error */
+    double m[PREFILTER_MAX_CHANNELS];/* the footprint's filtered channels */
+} FilteredSample;
+
+/* false when the sample falls outside the map (the techniques call it lit). */
+bool filtered_lookup(const FilteredMaps *fm, const TechContext *ctx, int s, FilteredSample *fs);
+
+/* course Eq. 4.2, the one-sided Chebyshev (Cantelli) bound on the lit
+ * fraction from a window's mean and second moment at reference d:
+ * p = var / (var + (d - mean)^2) for d > mean, else 1, with the variance
+ * (the text's "sigma", erratum 1) clamped below by min_variance. */
+double chebyshev_upper(double mean, double m2, double d, double min_variance);
+/* course §4.2.2: light-bleeding reduction, p < amount -> 0 and [amount, 1]
+ * smoothstep-remapped onto [0, 1]; amount 0 leaves p unchanged. */
+double bleed_reduce(double p, double amount);
+
+#endif
