@@ -11,6 +11,7 @@
  * image, averaged over the light (Fig. 3). The level reached is the aux
  * channel `level` (Table 2, Fig. 2). */
 #include <stdlib.h>
+#include "resources/prefilter.h"
 #include "resources/lightimage.h"
 #include "techniques/smap.h"
 
@@ -21,6 +22,8 @@ enum { P_THRESHOLD = SMAP_NUM_PARAMS, P_MAX_LEVEL, P_COLOR_THRESHOLD, P_FIXED, P
 #define AA_MAX_SEARCH_TAPS 32
 /* Nodes of a full quad tree down to AA_MAX_LEVEL: (4^(L+1) - 1) / 3. */
 #define AA_MAX_NODES 341
+/* Cuts of the search cone at the nearest possible blocker (search_depth). */
+#define AA_SEARCH_REFINEMENTS 3
 
 static const ParamDesc aa_params[] = {
     SMAP_MAP_PARAMS,
@@ -42,11 +45,12 @@ static const ParamDesc aa_params[] = {
      "blocker-search tests: search_taps x search_taps points over the cone's region on the near plane", NULL},
 };
 
-static const char *const aa_resources[] = {"shadow_map", "light_image_sat", "view_samples", NULL};
+static const char *const aa_resources[] = {"shadow_map", "minmax_pyramid", "light_image_sat", "view_samples", NULL};
 static const char *const aa_aux[] = {"level", NULL};
 
 typedef struct AaState {
     const ShadowMap *map;
+    const MinMaxPyramid *pyramid;
     SmapBias bias;
     double threshold, color_threshold;
     int max_level, taps, search_taps;
@@ -125,7 +129,8 @@ static bool aa_prepare(const TechContext *ctx, void **state, Error *err)
     st->fixed = p[P_FIXED] != 0.0;
     st->taps = (int)p[P_TAPS];
     st->search_taps = (int)p[P_SEARCH_TAPS];
-    if (!st->map || !light_axes(ctx, st, err) || !node_colors(ctx, st, err)) {
+    if (st->map) st->pyramid = res_minmax_pyramid(ctx->rm, st->map, err);
+    if (!st->pyramid || !light_axes(ctx, st, err) || !node_colors(ctx, st, err)) {
         free(st);
         return false;
     }
@@ -151,11 +156,40 @@ static bool region_texel(const Region *g, double u, double v, int *i, int *j)
     return *i >= 0 && *j >= 0 && *i < st->map->res && *j < st->map->res;
 }
 
+/* The depth where the blocker search cuts the cone (seed 001 §3: "the
+ * intersection [of the cone] on the shadow map is the initial filter area").
+ * Cut at the map's near plane the cone is needlessly wide wherever the near
+ * plane lies far in front of the casters (a ground plane reaching toward
+ * the light), so it is cut again at the nearest caster inside its bounding
+ * box, read from the min-max pyramid (resources/prefilter.h), a few times (course §5.2.3.4's
+ * search area refined through z_min, Fig. 5.9): no blocker can lie in front
+ * of that plane, so the region stays conservative. 0: nothing in front of
+ * the receiver, lit. */
+static double search_depth(const AaState *st, const SmapReceiver *r, double z_receiver)
+{
+    int face = r->mc.face;
+    double z = st->near_depth;
+    for (int it = 0; it < AA_SEARCH_REFINEMENTS; it++) {
+        double k = 1.0 / z - 1.0 / z_receiver;
+        double hs = 0.5 * k * (fabs(st->right_s) + fabs(st->up_s)), ht = 0.5 * k * (fabs(st->right_t) + fabs(st->up_t));
+        float lo, hi;
+        minmax_query(st->pyramid, face, (int)floor(r->mc.s - hs), (int)floor(r->mc.t - ht), (int)floor(r->mc.s + hs),
+                     (int)floor(r->mc.t + ht), &lo, &hi);
+        double z_min = smap_linear_depth(st->map, face, lo);
+        if (!(z_min < z_receiver)) return 0.0;
+        if (!(z_min > z)) break;
+        z = z_min;
+    }
+    return z;
+}
+
 /* Average linear depth of the blockers the search taps find over the cone's
- * region on the near plane (seed 001 §3, after Annen et al.); 0 when none. */
+ * region at the search depth (seed 001 §3, after Annen et al.); 0 when none. */
 static double average_blocker_depth(const AaState *st, const SmapReceiver *r, double z_receiver)
 {
-    Region g = {st, r, 1.0 / st->near_depth - 1.0 / z_receiver};
+    double z_search = search_depth(st, r, z_receiver);
+    if (!(z_search > 0.0)) return 0.0;
+    Region g = {st, r, 1.0 / z_search - 1.0 / z_receiver};
     int n = st->search_taps, found = 0;
     double sum = 0.0;
     for (int b = 0; b < n; b++)
