@@ -9,37 +9,11 @@
  * at the defaults and at the parameters' bounds. The comparisons with the
  * Embree reference are in test_filtered_reference.c. */
 #include <string.h>
+#include "filtered_fixtures.h"
 #include "fixtures.h"
 #include "resources/prefilter.h"
 #include "techniques/smap.h"
 #include "test.h"
-
-/* Parameters from a space-separated "name=value ..." list over the defaults. */
-static bool params_from(const Technique *t, const char *list, double *values)
-{
-    Error err;
-    char buf[512], *save = NULL;
-    tech_params_default(t, values);
-    snprintf(buf, sizeof buf, "%s", list ? list : "");
-    for (char *tok = strtok_r(buf, " ", &save); tok; tok = strtok_r(NULL, " ", &save))
-        if (!tech_param_parse(t, tok, values, &err)) {
-            printf("    %s\n", err.msg);
-            return false;
-        }
-    return true;
-}
-
-static bool run_tech(Lab *lab, const char *name, const char *list, RenderResult *out)
-{
-    Error err;
-    double values[TECH_MAX_PARAMS];
-    const Technique *t = tech_find(name, &err);
-    if (!t || !params_from(t, list, values)) return false;
-    RenderRequest rq = {.tech = t, .params = values, .light_index = 0, .repeat = 1};
-    if (lab_render(lab, &rq, out, &err)) return true;
-    printf("    %s %s: %s\n", name, list, err.msg);
-    return false;
-}
 
 /* Largest |a - b| over light-facing samples, and how many of them `b` puts
  * strictly inside (0.05, 0.95): the comparison must cross a penumbra. */
@@ -86,7 +60,7 @@ TEST(test_moment_methods_equal_pcf_for_parallel_planes)
         char p[256];
         snprintf(p, sizeof p, "%s %s", common, lookups[l][1]);
         RenderResult pcf;
-        CHECK(run_tech(lab, "pcf", p, &pcf));
+        CHECK(filtered_render(lab, "pcf", p, &pcf));
         for (int m = 0; m < 4; m++)
             for (int f = 0; f < 2; f++) {
                 /* EVSM's warped moments span e^-c+: a SAT's absolute rounding
@@ -94,7 +68,7 @@ TEST(test_moment_methods_equal_pcf_for_parallel_planes)
                 if (m == 2 && f == 1) continue;
                 RenderResult r;
                 snprintf(p, sizeof p, "%s %s %s %s", common, lookups[l][0], methods[m][1], prefilters[f]);
-                CHECK(run_tech(lab, methods[m][0], p, &r));
+                CHECK(filtered_render(lab, methods[m][0], p, &r));
                 Diff d = compare_images(lab, &r.visibility, &pcf.visibility);
                 printf("    %-4s %-15s %-13s: max |x - pcf| = %.2e over %ld samples (%ld in the penumbra)\n",
                        methods[m][0], lookups[l][0], prefilters[f], d.max_abs, d.candidates, d.penumbra);
@@ -155,7 +129,7 @@ static Bleed measure_bleeding(Lab *lab, const char *params, const Image *vsm, co
     Bleed b = {0};
     const Technique *t = tech_find("vsm", &err);
     double values[TECH_MAX_PARAMS];
-    if (!t || !params_from(t, params, values)) return b;
+    if (!t || !filtered_params(t, params, values)) return b;
     ShadowMapSpec spec = smap_spec(values);
     const ShadowMap *m = res_shadow_map(lab_resources(lab), lab_scene(lab), 0, &spec, &err);
     const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
@@ -186,17 +160,14 @@ static Bleed measure_bleeding(Lab *lab, const char *params, const Image *vsm, co
 
 TEST(test_vsm_bleeds_on_overlap_as_the_closed_form_says)
 {
-    Error err;
-    const char *ov[] = {"camera.width=240", "camera.height=180"};
-    Lab *lab = lab_open("scenes/overlap.lua", ov, 2, &err);
-    if (!lab) printf("    %s\n", err.msg);
+    Lab *lab = filtered_open("scenes/overlap.lua", 240, 180);
     CHECK(lab);
     const char *common = "map_size=1024 K=15";
     char pv[256], pp[256];
     snprintf(pv, sizeof pv, "%s lookup=nearest min_variance=0 prefilter=sat", common);
     snprintf(pp, sizeof pp, "%s kernel=box", common);
     RenderResult vsm, pcf;
-    CHECK(run_tech(lab, "vsm", pv, &vsm) && run_tech(lab, "pcf", pp, &pcf));
+    CHECK(filtered_render(lab, "vsm", pv, &vsm) && filtered_render(lab, "pcf", pp, &pcf));
     Bleed b = measure_bleeding(lab, pv, &vsm.visibility, &pcf.visibility, 15);
     printf("    %ld samples PCF calls umbra and VSM lights (> 0.05), up to %.3f; of %ld two-slab windows the\n"
            "    mean leak is %.4f measured, %.4f by the closed form, max |measured - closed form| %.1e;\n"
@@ -240,8 +211,7 @@ static long bad_samples(Lab *lab, const Image *im)
 TEST(test_esm_large_exponents_stay_finite_in_f32_and_f64)
 {
     Error err;
-    const char *ov[] = {"camera.width=160", "camera.height=120"};
-    Lab *lab = lab_open("scenes/contact.lua", ov, 2, &err);
+    Lab *lab = filtered_open("scenes/contact.lua", 160, 120);
     CHECK(lab);
     ShadowMapSpec spec = shadowmap_spec_default();
     spec.res = 512;
@@ -257,7 +227,7 @@ TEST(test_esm_large_exponents_stay_finite_in_f32_and_f64)
                 char p[256];
                 snprintf(p, sizeof p, "map_size=512 K=9 exponent=%d %s %s", c ? 200 : 80, cases[k], classifiers[q]);
                 RenderResult r;
-                CHECK(run_tech(lab, "esm", p, &r));
+                CHECK(filtered_render(lab, "esm", p, &r));
                 long bad = bad_samples(lab, &r.visibility);
                 CHECK_MSG(bad == 0, "esm %s: %ld samples NaN, Inf or outside [0, 1]", p, bad);
                 render_result_free(&r);
@@ -280,9 +250,7 @@ static void count_kind(Lab *lab, const char *kind, int *built, int *reused)
 
 TEST(test_vsm_kernel_sweep_builds_one_moment_map_and_one_sat)
 {
-    Error err;
-    const char *ov[] = {"camera.width=160", "camera.height=120"};
-    Lab *lab = lab_open("scenes/sphere-on-plane.lua", ov, 2, &err);
+    Lab *lab = filtered_open("scenes/sphere-on-plane.lua", 160, 120);
     CHECK(lab);
     int mb = 0, mr = 0, sb = 0, sr = 0, bb = 0, br = 0;
     for (int k = 3; k <= 31; k += 4)
@@ -291,7 +259,7 @@ TEST(test_vsm_kernel_sweep_builds_one_moment_map_and_one_sat)
             snprintf(p, sizeof p, "map_size=256 K=%d prefilter=%s", k, f ? "box" : "sat");
             RenderResult r;
             rm_log_reset(lab_resources(lab));
-            CHECK(run_tech(lab, "vsm", p, &r));
+            CHECK(filtered_render(lab, "vsm", p, &r));
             count_kind(lab, "moments", &mb, &mr);
             count_kind(lab, "sat", &sb, &sr);
             count_kind(lab, "box_blur", &bb, &br);
@@ -307,24 +275,14 @@ TEST(test_vsm_kernel_sweep_builds_one_moment_map_and_one_sat)
 
 /* ---- finite output on contacts, at the defaults and at the bounds ---- */
 
-/* The prefiltered techniques: those the registry says acquire moment maps. */
-static bool acquires_moments(const Technique *t)
-{
-    for (int i = 0; t->resources[i]; i++)
-        if (strcmp(t->resources[i], "moments") == 0) return true;
-    return false;
-}
-
 TEST(test_filtered_techniques_are_finite_on_contacts)
 {
-    Error err;
-    const char *ov[] = {"camera.width=120", "camera.height=90"};
-    Lab *lab = lab_open("scenes/contact.lua", ov, 2, &err);
+    Lab *lab = filtered_open("scenes/contact.lua", 120, 90);
     CHECK(lab);
     int techniques = 0, runs = 0;
     for (int ti = 0; ti < tech_count(); ti++) {
         const Technique *t = tech_at(ti);
-        if (!acquires_moments(t)) continue;
+        if (!filtered_acquires_moments(t)) continue;
         techniques++;
         /* The defaults, then each of the technique's own parameters at its
          * bounds (the stability suite covers every parameter). */
@@ -339,7 +297,7 @@ TEST(test_filtered_techniques_are_finite_on_contacts)
                 else snprintf(p, sizeof p, "map_size=256 %s=%.17g", d->name, end ? d->max : d->min);
                 if (pi < SMAP_NUM_PARAMS && end) continue;
                 RenderResult r;
-                CHECK(run_tech(lab, t->name, p, &r));
+                CHECK(filtered_render(lab, t->name, p, &r));
                 long bad = bad_samples(lab, &r.visibility);
                 CHECK_MSG(bad == 0, "%s %s: %ld samples NaN, Inf or outside [0, 1]", t->name, p, bad);
                 render_result_free(&r);
