@@ -35,6 +35,7 @@ int cmd_reference(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_run(int argc, char **argv);   /* script.c: a Lua script with the shadowlab module */
 int cmd_merge(int argc, char **argv); /* merge.c: shard records into one results folder */
+int cmd_aliasing(int argc, char **argv); /* aliasing.c: the sampling-error analysis of a map (course §3.1) */
 /* Run require(module).main(...) with the command's arguments; its integer result is the exit status. */
 int cli_lua_module_main(const char *command, const char *module, int argc, char **argv);
 

@@ -10,6 +10,7 @@ static const struct { const char *name; int (*run)(int, char **); const char *su
     {"compare", cmd_compare, "render, reference, metrics and every output"},
     {"run", cmd_run, "run a Lua script or experiment (sweeps, records, reports)"},
     {"merge", cmd_merge, "merge the records of a sweep's shards (--shard I/N)"},
+    {"aliasing", cmd_aliasing, "shadow-map sampling error of a technique's map: error maps, histogram, storage factor"},
 };
 #define NUM_COMMANDS (int)(sizeof commands / sizeof commands[0])
 

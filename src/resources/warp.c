@@ -257,8 +257,10 @@ static bool psm_homography(const MapFace *f, const WarpSetup *w, const double (*
                             : d3_normalize_or(d3_sub(C, d3_scale(Lxyz, 1.0 / L.w)), d3(0, 1, 0));
     double pi[4] = {dir.x, dir.y, dir.z, -d3_dot(dir, C)}, Lv[4] = {L.x, L.y, L.z, L.w};
     double piL = pi[0] * Lv[0] + pi[1] * Lv[1] + pi[2] * Lv[2] + pi[3] * Lv[3];
-    dvec3 e1 = d3_normalize_or(d3_cross(dir, fabs(dir.x) < 0.9 ? d3(1, 0, 0) : d3(0, 0, 1)), d3(1, 0, 0));
-    dvec3 e2 = d3_cross(dir, e1);
+    /* v follows the post-perspective depth axis, u runs across, as in the other warps */
+    dvec3 zaxis = d3_sub(d3(0, 0, 1), d3_scale(dir, dir.z));
+    dvec3 e2 = d3_normalize_or(zaxis, d3_normalize_or(d3_cross(dir, d3(1, 0, 0)), d3(0, 1, 0)));
+    dvec3 e1 = d3_cross(e2, dir);
     double R[3][4] = {{e1.x, e1.y, e1.z, -d3_dot(e1, C)}, {e2.x, e2.y, e2.z, -d3_dot(e2, C)}, {0, 0, 0, 1}};
     /* G: q -> X = Q p(q), p(q) on the ray of q (base z_ndc 1/2, homogeneous). */
     double G[4][3];

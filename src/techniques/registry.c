@@ -16,6 +16,7 @@ extern const Technique tech_esm;
 extern const Technique tech_csm;
 extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
+extern const Technique tech_aliasing;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -29,6 +30,7 @@ static const Technique *const registry[] = {
     &tech_csm,
     &tech_adaptive_area,
     &tech_shadow_width,
+    &tech_aliasing,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }

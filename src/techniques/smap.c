@@ -1,6 +1,7 @@
 /* smap.c -- shared shadow-map parameters, biases and lookups (smap.h). */
 #include "techniques/smap.h"
 #include <float.h>
+#include <string.h>
 
 const char *const smap_projection_names[] = {MAP_PROJ_NAMES, NULL};
 const char *const smap_fit_names[] = {MAP_FIT_NAMES, NULL};
@@ -26,6 +27,16 @@ ShadowMapSpec smap_spec(const double *p)
                                .select = (CascadeSelect)(int)p[SMAP_P_CASCADE_SELECT],
                                .blend = p[SMAP_P_CASCADE_BLEND]};
     return s;
+}
+
+bool smap_has_map_params(const Technique *t)
+{
+    static const ParamDesc shared[] = {SMAP_MAP_PARAMS};
+    int n = (int)(sizeof shared / sizeof shared[0]);
+    if (t->num_params < n) return false;
+    for (int i = 0; i < n; i++)
+        if (strcmp(t->params[i].name, shared[i].name) != 0 || t->params[i].type != shared[i].type) return false;
+    return true;
 }
 
 SmapBias smap_bias(const double *p, const Scene *scene)

@@ -112,6 +112,10 @@ enum {
 
 /* The map resource the parameters ask for (first layer, no culling). */
 ShadowMapSpec smap_spec(const double *params);
+/* Whether a technique's table starts with SMAP_MAP_PARAMS (so smap_spec
+ * reads its values): the map a technique renders with, for the analyses
+ * that measure it (`shadowlab aliasing -t TECH`). */
+bool smap_has_map_params(const Technique *t);
 
 typedef struct SmapBias {
     double constant_world, steps, slope, slope_max_texels, normal_offset_texels;

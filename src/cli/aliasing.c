@@ -1,0 +1,125 @@
+/* aliasing.c -- `shadowlab aliasing SCENE [-t TECH] [-p K=V]...`: the
+ * sampling-error analysis (course §3.1; resources/aliasing.h) of the shadow
+ * map a technique renders with -- any projection, warp, fit or cascades of
+ * the shared map parameters -- over the view samples, and Lloyd's measure
+ * over the view frustum; writes lab/aliasing_report.h's files and prints
+ * the summary. */
+#include <stdlib.h>
+#include <string.h>
+#include "cli/cli.h"
+#include "core/timer.h"
+#include "lab/aliasing_report.h"
+#include "techniques/smap.h"
+
+static const char *const help_text =
+    "usage: shadowlab aliasing SCENE [options]\n"
+    "  -t, --technique NAME   a shadow-map technique whose map is analysed (default aliasing)\n"
+    "  -p, --param K=V        its parameters (repeatable): map_size, projection, fit, warp_n, cascades, ...\n"
+    "  -s, --set KEY=V        scene override (repeatable)\n"
+    "  -l, --light N          light number (default 1)\n"
+    "  --frustum N            also Lloyd's measure over the view frustum at N x N image points x N depths\n"
+    "                         (perspective aliasing only; default 24, 0: off)\n"
+    "  --threads N            worker threads\n"
+    "  -o, --out DIR          output folder (default reports/SCENE-NAME)\n"
+    "  --no-png               skip the PNGs\n"
+    "writes DIR/aliasing.{exr,png,json}, aliasing-cascade.png, aliasing-hist.csv, aliasing-depth.csv:\n"
+    "m = pixels per texel step along the map's axes (> 1: undersampled), its histogram, its profile along\n"
+    "view depth, the projection factor cos(alpha)/cos(beta) and the storage factor (Lloyd et al. 2006)\n";
+
+/* Take `--frustum N` out of argv (cli_parse knows the shared options only). */
+static bool take_frustum(int *argc, char **argv, int *n, Error *err)
+{
+    for (int i = 1; i < *argc; i++) {
+        if (strcmp(argv[i], "--frustum") != 0) continue;
+        char *end = NULL;
+        long v = i + 1 < *argc ? strtol(argv[i + 1], &end, 10) : -1;
+        if (!end || *end || v < 0 || v > 256) return error_set(err, "--frustum expects an integer in [0, 256]");
+        *n = (int)v;
+        memmove(argv + i, argv + i + 2, sizeof *argv * (size_t)(*argc - i - 2));
+        *argc -= 2;
+        i--;
+    }
+    return true;
+}
+
+/* "name=value" of the map parameters that differ from the defaults. */
+static void params_text(const Technique *t, const double *p, char *out, size_t n)
+{
+    size_t used = 0;
+    out[0] = '\0';
+    for (int i = 0; i < SMAP_NUM_PARAMS && used < n; i++) {
+        if (p[i] == t->params[i].def && i > SMAP_P_FIT) continue;
+        char v[64];
+        tech_param_format(&t->params[i], p[i], v, sizeof v);
+        used += (size_t)snprintf(out + used, n - used, "%s%s=%s", used ? " " : "", t->params[i].name, v);
+    }
+}
+
+typedef struct AliasingJob {
+    CliOptions o;
+    const Technique *tech;
+    double params[TECH_MAX_PARAMS];
+    int frustum;
+} AliasingJob;
+
+static bool setup(AliasingJob *j, Error *err)
+{
+    j->tech = tech_find(j->o.technique ? j->o.technique : "aliasing", err);
+    if (!j->tech) return false;
+    if (!smap_has_map_params(j->tech))
+        return error_set(err, "%s renders no shadow map with the shared map parameters; the analysis measures the "
+                              "map of sm, pcf, aliasing and the other map techniques (see shadowlab list)",
+                         j->tech->name);
+    tech_params_default(j->tech, j->params);
+    for (int i = 0; i < j->o.num_params; i++)
+        if (!tech_param_parse(j->tech, j->o.params[i], j->params, err)) return false;
+    return true;
+}
+
+static bool analyse(AliasingJob *j, Lab *lab, Error *err)
+{
+    const Scene *sc = lab_scene(lab);
+    int light;
+    if (!lab_light_index(lab, j->o.light, &light, err)) return false;
+    if (!tech_check_light(j->tech, &sc->lights[light], j->o.light, err)) return false;
+    ResourceManager *rm = lab_resources(lab);
+    ShadowMapSpec spec = smap_spec(j->params);
+    const ShadowMap *map = res_shadow_map(rm, sc, light, &spec, err);
+    double t0 = timer_now_s();
+    const AliasingMap *an = map ? res_aliasing(rm, sc, light, map, err) : NULL;
+    if (!an) return false;
+    AliasingSummary fr;
+    if (j->frustum > 0) aliasing_frustum(&map->view, sc, &sc->lights[light], j->frustum, j->frustum, j->frustum, &fr);
+    char text[1024], dir[1024];
+    params_text(j->tech, j->params, text, sizeof text);
+    AliasingReport rep = {sc, j->tech->name, text, map, an, j->frustum > 0 ? &fr : NULL, timer_now_s() - t0};
+    if (j->o.out_dir) snprintf(dir, sizeof dir, "%s", j->o.out_dir);
+    else snprintf(dir, sizeof dir, "reports/%s", sc->name);
+    if (!aliasing_report_write(&rep, dir, "aliasing", !j->o.no_png, err)) return false;
+    aliasing_report_print(&rep, stdout);
+    printf("outputs: %s/aliasing{.exr,.json,.png,-cascade.png,-hist.csv,-depth.csv}\n", dir);
+    return true;
+}
+
+int cmd_aliasing(int argc, char **argv)
+{
+    AliasingJob j;
+    memset(&j, 0, sizeof j);
+    j.frustum = 24;
+    Error err;
+    if (!take_frustum(&argc, argv, &j.frustum, &err) || !cli_parse(argc, argv, true, &j.o, &err) ||
+        (!j.o.help && !setup(&j, &err))) {
+        fprintf(stderr, "shadowlab aliasing: %s\n", err.msg);
+        return EXIT_USAGE;
+    }
+    if (j.o.help) {
+        fputs(help_text, stdout);
+        return EXIT_OK;
+    }
+    cli_apply_threads(&j.o);
+    Lab *lab = lab_open(j.o.scene, j.o.overrides, j.o.num_overrides, &err);
+    bool ok = lab && analyse(&j, lab, &err);
+    if (!ok) fprintf(stderr, "shadowlab aliasing: %s\n", err.msg);
+    lab_close(lab);
+    return ok ? EXIT_OK : EXIT_RUNTIME;
+}

@@ -1,0 +1,93 @@
+/* aliasing.h -- the lab's measuring instrument for shadow-map sampling error
+ * (course §3.1). For a surface point seen by the camera, the Jacobian J of
+ * (screen pixel -> map texel) is measured through the map's actual mapping
+ * (any projection, warp or cascade: the face the point uses), by central
+ * differences of lightview_locate_on over the pixel's footprint on the
+ * point's tangent plane. The columns of J^-1 are the projected extents of
+ * one texel step along the map's axes s and t, in pixels: Lloyd's aliasing
+ * error m per axis (Eq. 3.2), undersampling where m > 1. The projection
+ * factor of Eq. 3.1, cos(alpha) / cos(beta) (alpha: normal to the eye,
+ * beta: normal to the light), is reported beside it; m divided by it is the
+ * perspective factor. The per-sample analysis is a resource (built only
+ * when asked for, keyed by the map and the view), with its summary:
+ * undersampled share, max and mean, histogram, profile along view depth,
+ * and Lloyd's storage factor. */
+#ifndef SL_ALIASING_H
+#define SL_ALIASING_H
+#include "resources/lightbody.h"
+#include "resources/shadowmap.h"
+
+#define ALIASING_M_CAP 1e9       /* m where J is singular (a texel seen edge-on): finite, undersampled */
+#define ALIASING_HIST_BINS 40    /* log10 m over [-2, 2] in 0.1 steps, first and last bins open */
+#define ALIASING_DEPTH_BINS 32   /* log view depth over [near, far] */
+
+/* The camera as the instrument needs it: frame and pixel size. */
+typedef struct AliasingView {
+    ViewFrustum frustum;
+    double pixel;                /* image-plane units per screen pixel at unit depth: 2 tan(fov_y / 2) / height */
+    int width, height;           /* screen pixels (the camera's, not supersampled) */
+} AliasingView;
+
+AliasingView aliasing_view(const Camera *cam);
+
+/* One measurement. */
+typedef struct AliasingPoint {
+    double m_s, m_t; /* pixels per texel step along s and along t */
+    double proj;     /* cos(alpha) / cos(beta) */
+    int face;
+    double depth;    /* view depth, world units */
+} AliasingPoint;
+
+/* Measure at surface point p (unit normal n); `to_light` is the unit
+ * direction from p toward the light. False where the point is outside the
+ * map, seen edge-on, or behind the eye. */
+bool aliasing_at(const LightView *lv, const AliasingView *av, dvec3 p, dvec3 n, dvec3 to_light, AliasingPoint *out);
+/* The unit direction from p toward a light (directional: -direction). */
+dvec3 aliasing_to_light(const Light *light, dvec3 p);
+
+typedef struct AliasingSummary {
+    long measured, undersampled;          /* samples measured; of them with max(m_s, m_t) > 1 */
+    double m_max, m_mean;                 /* of max(m_s, m_t) */
+    double m_s_max, m_t_max, m_s_mean, m_t_mean;
+    /* Lloyd's storage factor: texels the maps would need for m <= 1 at
+     * every measured point, over the screen's pixels, both axes:
+     * sum over faces of res^2 max(m_s) max(m_t) / (width height). */
+    double storage;
+    long hist[ALIASING_HIST_BINS];
+    double depth_lo, depth_hi;            /* the profile's range (the camera's near and far) */
+    long depth_count[ALIASING_DEPTH_BINS];
+    double depth_m_s[ALIASING_DEPTH_BINS], depth_m_t[ALIASING_DEPTH_BINS];       /* means */
+    double depth_m_s_max[ALIASING_DEPTH_BINS], depth_m_t_max[ALIASING_DEPTH_BINS];
+    double depth_persp_s[ALIASING_DEPTH_BINS], depth_persp_t[ALIASING_DEPTH_BINS]; /* means of m / proj */
+    int num_faces;
+    long face_count[LIGHTVIEW_MAX_FACES];
+    double face_m_s_max[LIGHTVIEW_MAX_FACES], face_m_t_max[LIGHTVIEW_MAX_FACES];
+} AliasingSummary;
+
+/* Accumulate measurements into a summary (res: texels per side of each face). */
+void aliasing_summary_init(AliasingSummary *s, int num_faces, double depth_lo, double depth_hi);
+void aliasing_summary_add(AliasingSummary *s, const AliasingPoint *pt);
+void aliasing_summary_finish(AliasingSummary *s, int res, int width, int height);
+/* Lower edge of histogram bin b as m (bin 0 also takes everything below). */
+double aliasing_hist_edge(int b);
+
+/* The per-sample analysis of a map over the view samples (lit candidates). */
+typedef struct AliasingMap {
+    int width, height;         /* the view-sample grid */
+    float *m_s, *m_t, *proj;   /* per sample; NAN where not measured */
+    int8_t *face;              /* -1 where not measured */
+    AliasingSummary sum;
+} AliasingMap;
+
+const AliasingMap *res_aliasing(ResourceManager *rm, const Scene *scene, int light_index, const ShadowMap *map,
+                                Error *err);
+
+/* Lloyd et al. 2006's measure over the view frustum, not the samples:
+ * perspective aliasing only (each point's normal bisects the directions to
+ * the eye and to the light, so cos(alpha) = cos(beta)), at an nx x ny grid
+ * of image positions times nz view depths (log spaced over near..far),
+ * inside the scene's bounds. */
+void aliasing_frustum(const LightView *lv, const Scene *scene, const Light *light, int nx, int ny, int nz,
+                      AliasingSummary *out);
+
+#endif
