@@ -14,6 +14,9 @@ extern const Technique tech_evsm;
 extern const Technique tech_msm;
 extern const Technique tech_esm;
 extern const Technique tech_csm;
+extern const Technique tech_accumulation;
+extern const Technique tech_brabec;
+extern const Technique tech_pcss;
 extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
 extern const Technique tech_aliasing;
@@ -28,6 +31,9 @@ static const Technique *const registry[] = {
     &tech_msm,
     &tech_esm,
     &tech_csm,
+    &tech_accumulation,
+    &tech_brabec,
+    &tech_pcss,
     &tech_adaptive_area,
     &tech_shadow_width,
     &tech_aliasing,

@@ -1,0 +1,221 @@
+/* brabec.c -- `brabec`: single-sample soft shadows on depth maps (Brabec &
+ * Seidel 2002; course §5.2.1; seed 003 §2, which describes it as Parker's
+ * algorithm, seed 002, carried over to depth maps). One depth map and
+ * object-id map from the light's centre; for a receiver p:
+ *   - lit by the hard test: search the map radially for the nearest blocked
+ *     texel; its distance d to the hard shadow's edge and its depth z_b place p
+ *     in that blocker's outer penumbra;
+ *   - shadowed: search for the nearest unblocked texel; d and the depth z_b of
+ *     p's own blocker place p in the inner penumbra.
+ * The placement [OWN: the papers available here give no formula]: a straight
+ * edge of a blocker at z_b casts a penumbra of half-width
+ *     w = a (z_p - z_b) / (z_p z_b)            (tangent units, a = light radius),
+ * centred on the hard edge (the same similar triangles as PCSS's window,
+ * course §5.2.2), so with tau = 1/2 + d / (2 w) outside and 1/2 - d / (2 w)
+ * inside, visibility is Parker's Bernstein interpolant 3 tau^2 - 2 tau^3
+ * (seed 002 §3) or tau. The search stops at the first texel found, at the
+ * widest penumbra any blocker beyond the near plane can cast, or at the
+ * search radius (course §5.2.1's failure: occluders beyond it are ignored).
+ * Blockers of the receiver's own object do not count unless self_shadow is
+ * on (seed 003 §2: "the algorithm allows no self-shadowing"). */
+#include <stdlib.h>
+#include "techniques/softmap.h"
+
+enum { FALLOFF_SMOOTH, FALLOFF_LINEAR };
+static const char *const falloff_names[] = {"smoothstep", "linear", NULL};
+
+enum { P_SEARCH = SMAP_NUM_PARAMS, P_FALLOFF, P_SELF_SHADOW };
+
+#define BRABEC_MAX_SEARCH 64
+
+static const ParamDesc brabec_params[] = {
+    SMAP_MAP_PARAMS,
+    SMAP_BIAS_PARAMS_PLANE(1),
+    {"search_radius", PARAM_INT, 32, 1, BRABEC_MAX_SEARCH, "texels",
+     "radius of the neighbourhood searched for the nearest blocked (or unblocked) texel", NULL},
+    {"falloff", PARAM_ENUM, FALLOFF_SMOOTH, 0, 1, "",
+     "visibility across the penumbra: smoothstep (Parker's 3 tau^2 - 2 tau^3, seed 002 §3) or linear",
+     falloff_names},
+    {"self_shadow", PARAM_BOOL, 0, 0, 1, "",
+     "let an object's own texels block it (off in the paper: blockers must carry another object id)", NULL},
+};
+
+static const char *const brabec_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", NULL};
+
+/* A texel offset of the search, nearest first. */
+typedef struct Offset { int16_t di, dj; float dist; } Offset;
+
+typedef struct BrabecState {
+    SoftMap sm;
+    SmapBias bias;
+    int falloff;
+    bool self_shadow;
+    int32_t *object_of_triangle; /* the map's triangle ids -> scene object, or NULL */
+    Offset *offsets;             /* within search_radius texels, sorted by tangent distance */
+    int num_offsets;
+    double search_tangent;       /* the search radius in tangent units */
+} BrabecState;
+
+static void brabec_release(void *state)
+{
+    BrabecState *st = state;
+    if (!st) return;
+    free(st->object_of_triangle);
+    free(st->offsets);
+    free(st);
+}
+
+static int by_distance(const void *a, const void *b)
+{
+    float x = ((const Offset *)a)->dist, y = ((const Offset *)b)->dist;
+    return (x > y) - (x < y);
+}
+
+/* The search order: every offset within the radius, nearest first (the
+ * tangent distance, so rectangular texels are searched radially too). */
+static bool make_offsets(BrabecState *st, int radius, Error *err)
+{
+    const SoftFace *f = &st->sm.face[0]; /* every face of a map has the same texel size */
+    int side = 2 * radius + 1;
+    st->offsets = malloc(sizeof *st->offsets * (size_t)side * (size_t)side);
+    if (!st->offsets) return error_set(err, "out of memory");
+    st->search_tangent = radius * fmin(f->dx, f->dy);
+    st->num_offsets = 0;
+    for (int dj = -radius; dj <= radius; dj++)
+        for (int di = -radius; di <= radius; di++) {
+            double d = hypot(di * f->dx, dj * f->dy);
+            if (d <= st->search_tangent) st->offsets[st->num_offsets++] = (Offset){(int16_t)di, (int16_t)dj, (float)d};
+        }
+    qsort(st->offsets, (size_t)st->num_offsets, sizeof *st->offsets, by_distance);
+    return true;
+}
+
+/* The map's triangle ids count the caster objects' triangles in scene order. */
+static bool make_object_table(BrabecState *st, const Scene *scene, Error *err)
+{
+    int total = 0;
+    for (int k = 0; k < scene->num_objects; k++) total += scene->objects[k].caster ? scene->objects[k].mesh.num_triangles : 0;
+    st->object_of_triangle = malloc(sizeof *st->object_of_triangle * (size_t)(total > 0 ? total : 1));
+    if (!st->object_of_triangle) return error_set(err, "out of memory");
+    int t = 0;
+    for (int k = 0; k < scene->num_objects; k++)
+        for (int i = 0; scene->objects[k].caster && i < scene->objects[k].mesh.num_triangles; i++)
+            st->object_of_triangle[t++] = k;
+    return true;
+}
+
+static bool brabec_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    const double *p = ctx->params;
+    BrabecState *st = calloc(1, sizeof *st);
+    if (!st) return error_set(err, "out of memory");
+    st->self_shadow = p[P_SELF_SHADOW] != 0.0;
+    ShadowMapSpec spec = smap_spec(p);
+    spec.triangle_ids = !st->self_shadow;
+    const ShadowMap *map = res_shadow_map(ctx->rm, ctx->scene, ctx->light_index, &spec, err);
+    bool ok = map && softmap_init(&st->sm, ctx->rm, map, ctx->light, "brabec", err) &&
+              make_offsets(st, (int)p[P_SEARCH], err) &&
+              (st->self_shadow || make_object_table(st, ctx->scene, err));
+    if (!ok) {
+        brabec_release(st);
+        return false;
+    }
+    st->bias = smap_bias(p, ctx->scene);
+    st->falloff = (int)p[P_FALLOFF];
+    *state = st;
+    return true;
+}
+
+/* Does texel (i, j) block the receiver (of scene object `object`)? */
+static bool blocked(const BrabecState *st, const SmapReceiver *r, int object, int i, int j)
+{
+    const ShadowMap *m = st->sm.map;
+    if (!(smap_ref_at(r, i, j) > shadowmap_texel(m, r->mc.face, i, j))) return false;
+    if (st->self_shadow) return true;
+    i = i < 0 ? 0 : i >= m->res ? m->res - 1 : i; /* clamped to the edge, as shadowmap_texel reads */
+    j = j < 0 ? 0 : j >= m->res ? m->res - 1 : j;
+    int32_t tri = m->triangle[((size_t)r->mc.face * (size_t)m->res + (size_t)j) * (size_t)m->res + (size_t)i];
+    return tri >= 0 && st->object_of_triangle[tri] != object;
+}
+
+/* Half-width of the penumbra a blocker at depth z_b casts at depth z_p (tangent units). */
+static double half_width(double a, double z_p, double z_b) { return a * (z_p - z_b) / (z_p * z_b); }
+
+/* The nearest texel whose blocked state is `want`, its centre within
+ * `limit` (tangent units) of p's own texel's; its distance from p to the
+ * texels' shared edge (half a texel before its centre) in *edge, the texel
+ * in *i, *j. */
+static bool nearest(const BrabecState *st, const SmapReceiver *r, int object, bool want, double limit, double *edge,
+                    int *i, int *j)
+{
+    const SoftFace *f = &st->sm.face[r->mc.face];
+    int i0, j0;
+    smap_texel(r, &i0, &j0);
+    double half_texel = 0.5 * fmin(f->dx, f->dy);
+    for (int k = 0; k < st->num_offsets && st->offsets[k].dist <= limit; k++) {
+        int ii = i0 + st->offsets[k].di, jj = j0 + st->offsets[k].dj;
+        if (blocked(st, r, object, ii, jj) != want) continue;
+        *edge = fmax(0.0, hypot(softmap_di(r, ii) * f->dx, softmap_dj(r, jj) * f->dy) - half_texel);
+        *i = ii;
+        *j = jj;
+        return true;
+    }
+    return false;
+}
+
+static double falloff(int kind, double tau)
+{
+    tau = fmin(fmax(tau, 0.0), 1.0);
+    return kind == FALLOFF_SMOOTH ? tau * tau * (3.0 - 2.0 * tau) : tau;
+}
+
+static float visibility(const BrabecState *st, const SmapReceiver *r, int object)
+{
+    const SoftFace *f = &st->sm.face[r->mc.face];
+    double a = f->light.radius_world, z_p = r->mc.depth_linear, z_n = f->near_world, edge;
+    int i, j;
+    smap_texel(r, &i, &j);
+    if (!blocked(st, r, object, i, j)) { /* outer penumbra: the nearest blocker */
+        double limit = fmin(half_width(a, z_p, z_n), st->search_tangent) + 0.5 * fmin(f->dx, f->dy);
+        int ri = (int)ceil(limit / f->dx), rj = (int)ceil(limit / f->dy); /* the offsets nearest() may visit */
+        if (!softmap_may_block(&st->sm, r, i - ri, j - rj, i + ri, j + rj) ||
+            !nearest(st, r, object, true, limit, &edge, &i, &j))
+            return 1.0f;
+        double w = half_width(a, z_p, fmax(softmap_depth(&st->sm, r->mc.face, i, j), z_n));
+        return w > 0.0 ? (float)falloff(st->falloff, 0.5 + edge / (2.0 * w)) : 1.0f;
+    }
+    /* inner penumbra: p's own blocker sets the width, the nearest unblocked texel the place */
+    double w = half_width(a, z_p, fmax(softmap_depth(&st->sm, r->mc.face, i, j), z_n));
+    double limit = fmin(w, st->search_tangent) + 0.5 * fmin(f->dx, f->dy);
+    if (!(w > 0.0) || !nearest(st, r, object, false, limit, &edge, &i, &j)) return 0.0f;
+    return (float)falloff(st->falloff, 0.5 - edge / (2.0 * w));
+}
+
+static void brabec_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
+{
+    const BrabecState *st = state;
+    for (int s = begin; s < end; s++) {
+        if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        SmapReceiver r;
+        float v = 1.0f;
+        if (smap_receiver(st->sm.map, &st->bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r))
+            v = visibility(st, &r, ctx->vs->object[s]);
+        tech_store(ctx, out, begin, s, v);
+    }
+}
+
+const Technique tech_brabec = {
+    .name = "brabec",
+    .family = "soft",
+    .source = "course §5.2.1 (Brabec & Seidel 2002), seed 003 §2; penumbra shape from seed 002 §3",
+    .summary = "radial search of the depth map for the nearest blocked (or unblocked) texel; its distance and "
+               "depth place the receiver in an outer (or inner) penumbra",
+    .params = brabec_params,
+    .num_params = (int)(sizeof brabec_params / sizeof brabec_params[0]),
+    .resources = brabec_resources,
+    .rgb = false,
+    .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),
+    .prepare = brabec_prepare,
+    .evaluate = brabec_evaluate,
+    .release = brabec_release,
+};
