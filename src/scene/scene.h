@@ -19,6 +19,12 @@ typedef struct Object {
     Mesh mesh;                   /* world space */
     vec3 albedo;                 /* diffuse reflectance, [0,1]^3 */
     bool caster, receiver;
+    /* The analytic sphere the mesh tessellates, for techniques that treat
+     * spheres exactly (seed 002's appendix): set for a procedural sphere under
+     * a uniform scale; the mesh stays the geometry everyone else traces. */
+    bool is_sphere;
+    vec3 sphere_center_world;
+    float sphere_radius_world;
 } Object;
 
 typedef struct Camera {

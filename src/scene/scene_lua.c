@@ -314,6 +314,19 @@ static bool read_transform(LuaReader *r, int idx, mat34 *M)
     return true;
 }
 
+/* A procedural sphere (object space: centred at the origin) keeps its
+ * analytic form when M scales it uniformly: M's columns then have one length. */
+static void record_sphere(Object *o, const mat34 *M)
+{
+    float len[3], r_object = 0.0f;
+    for (int c = 0; c < 3; c++) len[c] = v3_len(v3(M->m[0][c], M->m[1][c], M->m[2][c]));
+    if (fabsf(len[1] - len[0]) > 1e-6f * len[0] || fabsf(len[2] - len[0]) > 1e-6f * len[0]) return;
+    for (int v = 0; v < o->mesh.num_vertices; v++) r_object = fmaxf(r_object, v3_len(o->mesh.positions[v]));
+    o->is_sphere = true;
+    o->sphere_center_world = v3(M->m[0][3], M->m[1][3], M->m[2][3]);
+    o->sphere_radius_world = len[0] * r_object;
+}
+
 static bool read_object(LuaReader *r, int idx, Object *o, int index, const SceneLoadCtx *ctx)
 {
     int shape;
@@ -325,6 +338,7 @@ static bool read_object(LuaReader *r, int idx, Object *o, int index, const Scene
         !rd_vec3(r, idx, "albedo", RANGE_CLOSED(0, 1), false, v3(0.8f, 0.8f, 0.8f), &o->albedo) ||
         !read_transform(r, idx, &M) || !build_shape(r, idx, shape, o, ctx))
         return false;
+    if (shape == SHAPE_SPHERE) record_sphere(o, &M);
     mesh_transform(&o->mesh, &M);
     return true;
 }
