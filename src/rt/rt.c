@@ -42,6 +42,8 @@ static RTCDevice get_device(Error *err)
     return device;
 }
 
+RTCDevice rt_device(Error *err) { return get_device(err); }
+
 static bool add_mesh(RtScene *rs, RTCDevice dev, const Mesh *m, Error *err)
 {
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);

@@ -17,6 +17,9 @@ typedef enum RtGeometrySet {
 
 /* Thread count Embree's builders use; call before the first rt_scene_create. */
 void rt_set_threads(int threads);
+/* The process's one Embree device (created on first use), for rt/ modules
+ * that build geometry of their own (outer.c); NULL + err on failure. */
+RTCDevice rt_device(Error *err);
 RtScene *rt_scene_create(const Scene *scene, RtGeometrySet set, Error *err);
 void rt_scene_release(RtScene *rs);
 RTCScene rt_scene_handle(const RtScene *rs);

@@ -14,6 +14,7 @@ extern const Technique tech_evsm;
 extern const Technique tech_msm;
 extern const Technique tech_esm;
 extern const Technique tech_csm;
+extern const Technique tech_single_sample_rt;
 extern const Technique tech_accumulation;
 extern const Technique tech_brabec;
 extern const Technique tech_pcss;
@@ -31,6 +32,7 @@ static const Technique *const registry[] = {
     &tech_msm,
     &tech_esm,
     &tech_csm,
+    &tech_single_sample_rt,
     &tech_accumulation,
     &tech_brabec,
     &tech_pcss,
