@@ -223,18 +223,6 @@ static bool run_round(const Inputs *in, const ReferenceParams *prm, double *bare
     return ok;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 static bool measure(const Inputs *in, const Options *o, Result *res, Error *err)
 {
     ReferenceParams prm = ref_params(o);
@@ -246,7 +234,8 @@ static bool measure(const Inputs *in, const Options *o, Result *res, Error *err)
         ok = run_round(in, &prm, &bare[i], &ref[i], err);
         ratio[i] = bare[i] / ref[i];
     }
-    if (ok) *res = (Result){median(bare, o->repeat), median(ref, o->repeat), median(ratio, o->repeat)};
+    if (ok)
+        *res = (Result){timer_median(bare, o->repeat), timer_median(ref, o->repeat), timer_median(ratio, o->repeat)};
     free(t);
     return ok;
 }

@@ -35,3 +35,13 @@ else
     bench scenes/bunny.lua "$2" "$3" "$4"
 fi
 echo "results: $csv"
+
+# seed 002 §4's "approximately 20% slower": single_sample_rt against hard,
+# on the sphere scene (its Fig. 4) across light radii and on the bunny (a
+# tessellated model, its Fig. 5) when found.
+ss="$(dirname "$bin")/single_sample_overhead"
+if [ -x "$ss" ]; then
+    ss_scenes=scenes/sphere-on-plane.lua
+    [ -f scenes/bunny.lua ] && bunny_found && ss_scenes="$ss_scenes scenes/bunny.lua"
+    "$ss" --radius 0.05 --radius 0.2 --radius 0.4 --radius 0.8 --threads "$3" --repeat "$4" $ss_scenes
+fi
