@@ -11,6 +11,8 @@
 #include "lab/aliasing_report.h"
 #include "techniques/smap.h"
 
+#define AXIS_POINTS 64 /* view depths of the axis profile, log spaced over near..far */
+
 static const char *const help_text =
     "usage: shadowlab aliasing SCENE [options]\n"
     "  -t, --technique NAME   a shadow-map technique whose map is analysed (default aliasing)\n"
@@ -22,9 +24,10 @@ static const char *const help_text =
     "  --threads N            worker threads\n"
     "  -o, --out DIR          output folder (default reports/SCENE-NAME)\n"
     "  --no-png               skip the PNGs\n"
-    "writes DIR/aliasing.{exr,png,json}, aliasing-cascade.png, aliasing-hist.csv, aliasing-depth.csv:\n"
-    "m = pixels per texel step along the map's axes (> 1: undersampled), its histogram, its profile along\n"
-    "view depth, the projection factor cos(alpha)/cos(beta) and the storage factor (Lloyd et al. 2006)\n";
+    "writes DIR/aliasing.{exr,png,json}, aliasing-cascade.png, aliasing-hist.csv, aliasing-depth.csv,\n"
+    "aliasing-axis.csv: m = pixels per texel step along the map's axes (> 1: undersampled), its histogram,\n"
+    "its profile along view depth, the projection factor cos(alpha)/cos(beta), the storage factor (Lloyd et\n"
+    "al. 2006), and along the view axis the catalogue's normalised e_x, e_y (course Fig. 3.7)\n";
 
 /* Take `--frustum N` out of argv (cli_parse knows the shared options only). */
 static bool take_frustum(int *argc, char **argv, int *n, Error *err)
@@ -90,14 +93,23 @@ static bool analyse(AliasingJob *j, Lab *lab, Error *err)
     if (!an) return false;
     AliasingSummary fr;
     if (j->frustum > 0) aliasing_frustum(&map->view, sc, &sc->lights[light], j->frustum, j->frustum, j->frustum, &fr);
+    AliasingPoint axis[AXIS_POINTS];
+    AliasingView av = aliasing_view(&sc->camera);
+    for (int i = 0; i < AXIS_POINTS; i++) {
+        double z = sc->camera.near_dist * pow(sc->camera.far_dist / sc->camera.near_dist, (double)i / (AXIS_POINTS - 1));
+        z *= 1.0 + 1e-9 * (i == 0) - 1e-9 * (i == AXIS_POINTS - 1); /* a hair inside the ends */
+        if (!aliasing_on_axis(&map->view, &av, &sc->lights[light], z, &axis[i])) axis[i] = (AliasingPoint){.face = -1};
+        axis[i].depth = z;
+    }
     char text[1024], dir[1024];
     params_text(j->tech, j->params, text, sizeof text);
-    AliasingReport rep = {sc, j->tech->name, text, map, an, j->frustum > 0 ? &fr : NULL, timer_now_s() - t0};
+    AliasingReport rep = {sc, j->tech->name, text, map, an, j->frustum > 0 ? &fr : NULL, axis, AXIS_POINTS,
+                          timer_now_s() - t0};
     if (j->o.out_dir) snprintf(dir, sizeof dir, "%s", j->o.out_dir);
     else snprintf(dir, sizeof dir, "reports/%s", sc->name);
     if (!aliasing_report_write(&rep, dir, "aliasing", !j->o.no_png, err)) return false;
     aliasing_report_print(&rep, stdout);
-    printf("outputs: %s/aliasing{.exr,.json,.png,-cascade.png,-hist.csv,-depth.csv}\n", dir);
+    printf("outputs: %s/aliasing{.exr,.json,.png,-cascade.png,-hist.csv,-depth.csv,-axis.csv}\n", dir);
     return true;
 }
 

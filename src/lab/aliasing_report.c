@@ -10,7 +10,7 @@
 #include "io/image_file.h"
 #include "resources/standard.h"
 
-#define NUM_FILES 6
+#define NUM_FILES 7
 
 void aliasing_color(double m, float rgb[3])
 {
@@ -107,6 +107,22 @@ static bool write_depth(const AliasingSummary *s, const char *path, Error *err)
     return atomic_commit(&af, err);
 }
 
+static bool write_axis(const AliasingReport *r, const char *path, Error *err)
+{
+    AtomicFile af;
+    if (!atomic_open(&af, path, err)) return false;
+    AliasingView av = aliasing_view(&r->scene->camera);
+    fprintf(af.fp, "z,cascade,m_s,m_t,e_x,e_y\n");
+    for (int i = 0; i < r->num_axis; i++) {
+        const AliasingPoint *p = &r->axis[i];
+        double ex = NAN, ey = NAN;
+        if (p->face >= 0) aliasing_normalised(&av, r->map->res, p, &ex, &ey);
+        fprintf(af.fp, "%.6g,%d,%.6g,%.6g,%.6g,%.6g\n", p->depth, p->face + 1, p->face >= 0 ? p->m_s : NAN,
+                p->face >= 0 ? p->m_t : NAN, ex, ey);
+    }
+    return atomic_commit(&af, err);
+}
+
 static void json_summary(JsonWriter *w, const char *key, const AliasingSummary *s)
 {
     json_object_begin(w, key);
@@ -162,12 +178,14 @@ static bool write_json(const AliasingReport *r, const char *path, Error *err)
 bool aliasing_report_write(const AliasingReport *r, const char *dir, const char *stem, bool png, Error *err)
 {
     if (!mkdir_p(dir, err)) return false;
-    static const char *const suffix[NUM_FILES] = {".exr", ".png", "-cascade.png", "-hist.csv", "-depth.csv", ".json"};
+    static const char *const suffix[NUM_FILES] = {".exr",       ".png",     "-cascade.png", "-hist.csv",
+                                                  "-depth.csv", "-axis.csv", ".json"};
     char path[NUM_FILES][1200];
     for (int k = 0; k < NUM_FILES; k++) snprintf(path[k], sizeof path[k], "%s/%s%s", dir, stem, suffix[k]);
     const AliasingSummary *s = &r->samples->sum;
     bool ok = write_exr(r, path[0], err) && (!png || write_pngs(r, path[1], path[2], err)) &&
-              write_hist(s, path[3], err) && write_depth(s, path[4], err) && write_json(r, path[5], err);
+              write_hist(s, path[3], err) && write_depth(s, path[4], err) && write_axis(r, path[5], err) &&
+              write_json(r, path[6], err);
     if (!ok)
         for (int k = 0; k < NUM_FILES; k++) unlink(path[k]);
     return ok;

@@ -15,12 +15,14 @@
 
 typedef struct LuaLab { Lab *lab; } LuaLab;
 
-static Lab *check_lab(lua_State *L)
+Lab *sl_check_lab(lua_State *L, int idx)
 {
-    LuaLab *ll = luaL_checkudata(L, 1, SL_LAB_TYPE);
+    LuaLab *ll = luaL_checkudata(L, idx, SL_LAB_TYPE);
     if (!ll->lab) luaL_error(L, "the lab is closed");
     return ll->lab;
 }
+
+static Lab *check_lab(lua_State *L) { return sl_check_lab(L, 1); }
 
 /* ---- sl.open ------------------------------------------------------------ */
 

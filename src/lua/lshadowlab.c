@@ -112,6 +112,7 @@ int luaopen_shadowlab(lua_State *L)
     find_root();
     add_lua_path(L);
     sl_register_lab(L);
+    sl_register_aliasing(L);
     sl_register_run(L);
     sl_register_image(L);
     luaL_newlib(L, funcs);

@@ -62,6 +62,26 @@ bool aliasing_at(const LightView *lv, const AliasingView *av, dvec3 p, dvec3 n, 
     return true;
 }
 
+/* The instrument at p for a surface element facing the eye and the light alike. */
+static bool half_vector_at(const LightView *lv, const AliasingView *av, const Light *light, dvec3 p, AliasingPoint *out)
+{
+    dvec3 to_eye = d3_normalize_or(d3_sub(av->frustum.eye, p), d3_scale(av->frustum.fwd, -1));
+    dvec3 to_light = aliasing_to_light(light, p);
+    dvec3 n = d3_normalize_or(d3_add(to_eye, to_light), to_eye); /* the half vector */
+    return aliasing_at(lv, av, p, n, to_light, out);
+}
+
+bool aliasing_on_axis(const LightView *lv, const AliasingView *av, const Light *light, double z, AliasingPoint *out)
+{
+    return half_vector_at(lv, av, light, d3_madd(av->frustum.eye, av->frustum.fwd, z), out);
+}
+
+void aliasing_normalised(const AliasingView *av, int res, const AliasingPoint *pt, double *e_x, double *e_y)
+{
+    *e_y = pt->m_t * res * av->pixel;
+    *e_x = pt->m_s * res / av->width;
+}
+
 /* ---- summaries ------------------------------------------------------------------- */
 
 double aliasing_hist_edge(int b) { return pow(10.0, -2.0 + 4.0 * b / ALIASING_HIST_BINS); }
@@ -242,11 +262,8 @@ void aliasing_frustum(const LightView *lv, const Scene *scene, const Light *ligh
         for (int j = 0; j < ny; j++)
             for (int i = 0; i < nx; i++) {
                 dvec3 p = frustum_point(f, 2.0 * (i + 0.5) / nx - 1.0, 2.0 * (j + 0.5) / ny - 1.0, d);
-                if (!inside_box(scene, p)) continue;
-                dvec3 to_eye = d3_normalize_or(d3_sub(f->eye, p), f->fwd), to_light = aliasing_to_light(light, p);
-                dvec3 n = d3_normalize_or(d3_add(to_eye, to_light), to_eye); /* the half vector */
                 AliasingPoint pt;
-                if (aliasing_at(lv, &av, p, n, to_light, &pt)) aliasing_summary_add(out, &pt);
+                if (inside_box(scene, p) && half_vector_at(lv, &av, light, p, &pt)) aliasing_summary_add(out, &pt);
             }
     }
     aliasing_summary_finish(out, lv->res, scene->camera.width, scene->camera.height);

@@ -44,6 +44,14 @@ typedef struct AliasingPoint {
 bool aliasing_at(const LightView *lv, const AliasingView *av, dvec3 p, dvec3 n, dvec3 to_light, AliasingPoint *out);
 /* The unit direction from p toward a light (directional: -direction). */
 dvec3 aliasing_to_light(const Light *light, dvec3 p);
+/* The setting of course §3.1.2 and Fig. 3.7: a surface element on the view
+ * axis at view depth z whose normal bisects the directions to the eye and
+ * to the light (cos alpha = cos beta: perspective aliasing only). */
+bool aliasing_on_axis(const LightView *lv, const AliasingView *av, const Light *light, double z, AliasingPoint *out);
+/* m as the catalogue's normalised dp/ds (course §3.1.2): e_y in image-plane
+ * units at unit depth per map height, e_x in viewport widths per map width
+ * (so a uniform map fitted to z_n..z_f has e_y = (z_f - z_n)/z, e_x = z_f/z). */
+void aliasing_normalised(const AliasingView *av, int res, const AliasingPoint *pt, double *e_x, double *e_y);
 
 typedef struct AliasingSummary {
     long measured, undersampled;          /* samples measured; of them with max(m_s, m_t) > 1 */

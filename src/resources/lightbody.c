@@ -104,17 +104,59 @@ static void clip_body(Body *b, BodyPlane pl)
     if (ncut >= 3 && b->nf < MAX_FACES) cap_face(pl.n, cut, ncut, &b->f[b->nf++]);
 }
 
+/* The scene's bounds grown by 1e-6 of its extent, as six kept half-spaces. */
+static void box_planes(const Scene *scene, BodyPlane *box)
+{
+    double grow = 1e-6 * scene_extent(scene);
+    dvec3 lo = d3_from(scene->bounds_min), hi = d3_from(scene->bounds_max);
+    box[0] = (BodyPlane){d3(1, 0, 0), -lo.x + grow};
+    box[1] = (BodyPlane){d3(-1, 0, 0), hi.x + grow};
+    box[2] = (BodyPlane){d3(0, 1, 0), -lo.y + grow};
+    box[3] = (BodyPlane){d3(0, -1, 0), hi.y + grow};
+    box[4] = (BodyPlane){d3(0, 0, 1), -lo.z + grow};
+    box[5] = (BodyPlane){d3(0, 0, -1), hi.z + grow};
+}
+
+FrustumFace frustum_face(const ViewFrustum *f, int face)
+{
+    Body b;
+    slice_body(f, f->near, f->far, &b);
+    const Poly *p = &b.f[face];
+    FrustumFace ff;
+    dvec3 centre = d3_scale(d3_add(frustum_point(f, 0, 0, f->near), frustum_point(f, 0, 0, f->far)), 0.5);
+    ff.n = d3_normalize_or(d3_cross(d3_sub(p->v[1], p->v[0]), d3_sub(p->v[2], p->v[0])), f->fwd);
+    if (d3_dot(ff.n, d3_sub(centre, p->v[0])) > 0.0) ff.n = d3_scale(ff.n, -1); /* outward */
+    ff.d = -d3_dot(ff.n, p->v[0]);
+    for (int k = 0; k < 4; k++) ff.corner[k] = p->v[k];
+    /* slice_body's side quads list a near edge (corners 0, 1) and a far edge (2, 3) */
+    bool side = face >= FRUSTUM_BOTTOM;
+    ff.near_mid = d3_scale(d3_add(p->v[0], side ? p->v[1] : p->v[2]), 0.5);
+    ff.far_mid = d3_scale(d3_add(side ? p->v[2] : p->v[0], side ? p->v[3] : p->v[2]), 0.5);
+    return ff;
+}
+
+int frustum_face_prism(const FrustumFace *ff, bool point, dvec3 light, BodyPlane *out)
+{
+    dvec3 c = d3_scale(d3_add(d3_add(ff->corner[0], ff->corner[1]), d3_add(ff->corner[2], ff->corner[3])), 0.25);
+    int n = 0;
+    for (int k = 0; k < 4; k++) {
+        dvec3 a = ff->corner[k], b = ff->corner[(k + 1) % 4];
+        dvec3 along = point ? d3_sub(a, light) : light;
+        dvec3 nrm = d3_normalize_or(d3_cross(d3_sub(b, a), along), d3(0, 0, 0));
+        if (d3_len(nrm) == 0.0) continue; /* an edge along the light's rays bounds nothing */
+        if (d3_dot(nrm, d3_sub(c, a)) < 0.0) nrm = d3_scale(nrm, -1); /* keep the face's side */
+        out[n++] = (BodyPlane){nrm, -d3_dot(nrm, a)};
+    }
+    return n;
+}
+
 int body_points(const ViewFrustum *f, double d0, double d1, const Scene *scene, const BodyPlane *extra, int n_extra,
                 dvec3 *out, int max_out)
 {
     Body b;
     slice_body(f, d0, d1, &b);
-    double grow = 1e-6 * scene_extent(scene);
-    dvec3 lo = d3_from(scene->bounds_min), hi = d3_from(scene->bounds_max);
-    const BodyPlane box[6] = {
-        {d3(1, 0, 0), -lo.x + grow}, {d3(-1, 0, 0), hi.x + grow}, {d3(0, 1, 0), -lo.y + grow},
-        {d3(0, -1, 0), hi.y + grow}, {d3(0, 0, 1), -lo.z + grow}, {d3(0, 0, -1), hi.z + grow},
-    };
+    BodyPlane box[6];
+    box_planes(scene, box);
     for (int k = 0; k < 6 && b.nf; k++) clip_body(&b, box[k]);
     for (int k = 0; k < n_extra && b.nf; k++) clip_body(&b, extra[k]);
     int n = 0;

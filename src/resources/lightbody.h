@@ -34,6 +34,21 @@ typedef struct BodyPlane { dvec3 n; double d; } BodyPlane;
  * a thin body) and the extra planes; 0 when the slice misses them. */
 int body_points(const ViewFrustum *f, double d0, double d1, const Scene *scene, const BodyPlane *extra, int n_extra,
                 dvec3 *out, int max_out);
+/* The six faces of the frustum, in this order (frustum-face partitioning,
+ * course §3.2.3.2). */
+enum { FRUSTUM_NEAR, FRUSTUM_FAR, FRUSTUM_BOTTOM, FRUSTUM_TOP, FRUSTUM_LEFT, FRUSTUM_RIGHT, FRUSTUM_FACES };
+/* Face `face` of the frustum: its outward unit normal and offset (n.p + d
+ * = 0 on the plane, > 0 outside), its four corners in order, and their
+ * mid-points at the near and at the far end (side faces; the face's centre
+ * twice for the near and far faces). */
+typedef struct FrustumFace { dvec3 n; double d; dvec3 corner[4]; dvec3 near_mid, far_mid; } FrustumFace;
+FrustumFace frustum_face(const ViewFrustum *f, int face);
+/* The planes through the face's edges along the light's rays (direction
+ * `dir`, or through the light's centre when `point`): with the face's own
+ * plane they bound the points whose ray toward the light leaves the
+ * frustum through this face. */
+int frustum_face_prism(const FrustumFace *ff, bool point, dvec3 light, BodyPlane *out);
+
 /* The four side planes and the apex plane of a spot light's cone. */
 int spot_cone_planes(const Light *light, BodyPlane *out);
 

@@ -418,22 +418,86 @@ typedef struct FitJob {
     const ViewFrustum *view;
 } FitJob;
 
-static bool fit_face(LightView *lv, int index, const FitJob *j, const Target *tg, Error *err)
+/* Face `index` with the job's projection (or `proj`, when not AUTO), its
+ * warp along the view axis (or along axis[0] -> axis[1] when given). */
+static bool fit_face_along(LightView *lv, int index, const FitJob *j, const Target *tg, MapProjection proj,
+                           const dvec3 *axis, Error *err)
 {
     bool directional = j->light->kind == LIGHT_DIRECTIONAL;
-    bool warp = is_warp(j->projection);
+    MapProjection projection = proj != MAP_PROJ_AUTO ? proj : j->projection;
+    bool warp = is_warp(projection);
     FaceOpts o = {.aligned = !j->params->stabilize && (warp || is_body(j->fit) || j->params->cascades > 1),
                   .up = j->view->fwd, .square = warp, .stabilize = j->params->stabilize};
     MapFace *f = &lv->face[index];
     bool ok = directional ? fit_ortho(f, lv->res, j->light, j->fit, tg, &o, err)
                           : fit_perspective(f, lv->res, j->light, j->fit, tg, &o, err);
     if (!ok || !warp) return ok;
-    WarpSetup w = {.kind = j->projection, .params = j->params, .view = j->view, .directional = directional,
+    WarpSetup w = {.kind = projection, .params = j->params, .view = j->view, .directional = directional,
                    .light_axis = directional ? d3_normalize_or(d3_from(j->light->direction), d3(0, -1, 0))
                                              : f->axis_world,
                    .light_pos = d3_from(j->light->position), .pts = tg->pts, .n = tg->n,
-                   .z_min = tg->z_min, .z_max = tg->z_max};
+                   .z_min = tg->z_min, .z_max = tg->z_max, .has_axis = axis != NULL};
+    if (axis) {
+        w.axis_from = axis[0];
+        w.axis_to = axis[1];
+    }
     return warp_face(f, lv->res, &w, err);
+}
+
+static bool fit_face(LightView *lv, int index, const FitJob *j, const Target *tg, Error *err)
+{
+    return fit_face_along(lv, index, j, tg, MAP_PROJ_AUTO, NULL, err);
+}
+
+/* ---- frustum-face partitioning (course §3.2.3.2; Lloyd et al. 2006) -------------- */
+
+/* Whether the light reaches the frustum through this face from outside. */
+static bool face_lit(const Light *light, const FrustumFace *ff, dvec3 on_face)
+{
+    if (light->kind == LIGHT_DIRECTIONAL) return d3_dot(ff->n, d3_from(light->direction)) < -1e-9;
+    return d3_dot(ff->n, d3_sub(d3_from(light->position), on_face)) > 1e-9 * d3_len(d3_sub(d3_from(light->position), on_face));
+}
+
+/* One map per light-facing face, fitted to the part of B whose rays toward
+ * the light leave the frustum through that face (B clipped by the planes
+ * through the face's edges along the rays): the side faces warped along the
+ * face, from its near edge to its far edge, the near and far faces (each at
+ * one view depth) uniform. A point uses the face its ray leaves through. */
+static bool fit_face_partition(LightView *lv, const FitJob *j, Error *err)
+{
+    bool point = j->light->kind != LIGHT_DIRECTIONAL;
+    dvec3 light = point ? d3_from(j->light->position) : d3_from(j->light->direction);
+    int k = 0;
+    for (int face = 0; face < FRUSTUM_FACES; face++) {
+        FrustumFace ff = frustum_face(j->view, face);
+        const double inward[4] = {-ff.n.x, -ff.n.y, -ff.n.z, -ff.d};
+        memcpy(lv->face_plane[face], inward, sizeof inward);
+        lv->face_of_plane[face] = -1;
+        if (!face_lit(j->light, &ff, ff.near_mid)) continue;
+        Target tg;
+        if (!target_init(j->scene, j->light, MAP_FIT_SCENE, NULL, NULL, j->view, j->view->near, j->view->far, &tg, err))
+            return false;
+        BodyPlane planes[9];
+        int np = frustum_face_prism(&ff, point, light, planes);
+        if (j->light->kind == LIGHT_SPOT) np += spot_cone_planes(j->light, planes + np);
+        int n = body_points(j->view, j->view->near, j->view->far, j->scene, planes, np, tg.pts, BODY_MAX_POINTS);
+        bool ok = true;
+        if (n > 0) { /* else no visible point's ray leaves through this face */
+            tg.n = n;
+            target_depths(&tg, j->view, j->view->near, j->view->far);
+            bool side = face >= FRUSTUM_BOTTOM;
+            MapProjection flat = point ? MAP_PROJ_PERSPECTIVE : MAP_PROJ_ORTHO;
+            const dvec3 axis[2] = {ff.near_mid, ff.far_mid};
+            ok = fit_face_along(lv, k, j, &tg, side ? MAP_PROJ_AUTO : flat, side ? axis : NULL, err);
+            lv->face_of_plane[face] = k++;
+        }
+        free(tg.pts);
+        if (!ok) return false;
+    }
+    lv->num_faces = k;
+    lv->face_partition = k > 0;
+    lv->num_face_planes = FRUSTUM_FACES;
+    return true;
 }
 
 /* ---- refusals -------------------------------------------------------------------- */
@@ -512,22 +576,26 @@ bool lightview_fit_with(const Scene *scene, const Light *light, MapProjection pr
     lv->res = res;
     lv->origin_world = d3_from(light->position);
     lv->light_dir = d3_normalize_or(d3_from(light->direction), d3(0, -1, 0));
+    lv->directional = light->kind == LIGHT_DIRECTIONAL;
     Target tg;
     if (!target_init(scene, light, fit, vs, cls, &vf, vf.near, vf.far, &tg, err)) return false;
     lv->projection = projection == MAP_PROJ_AUTO ? resolve_auto(light, &tg) : projection;
     FitJob j = {scene, light, lv->projection, fit, &lp, &vf};
-    bool ok;
-    if (lp.cascades > 1) {
+    bool ok = true, done = false;
+    if (lp.split == SPLIT_FACES) { /* no light-facing face (a point light inside the frustum): one map */
+        ok = fit_face_partition(lv, &j, err);
+        done = !ok || lv->num_faces > 0;
+    }
+    if (done) {
+    } else if (lp.cascades > 1) {
         ok = fit_cascades(lv, &j, vs, cls, vf.near, vf.far, err);
+    } else if (lv->projection == MAP_PROJ_CUBE) {
+        ok = fit_cube(lv, light, &tg, err);
+    } else if (lv->projection == MAP_PROJ_PARABOLOID) {
+        ok = fit_paraboloid(lv, light, &tg);
     } else {
-        switch (lv->projection) {
-        case MAP_PROJ_CUBE: ok = fit_cube(lv, light, &tg, err); break;
-        case MAP_PROJ_PARABOLOID: ok = fit_paraboloid(lv, light, &tg); break;
-        default:
-            lv->num_faces = 1;
-            ok = fit_face(lv, 0, &j, &tg, err);
-            break;
-        }
+        lv->num_faces = 1;
+        ok = fit_face(lv, 0, &j, &tg, err);
     }
     free(tg.pts);
     return ok;

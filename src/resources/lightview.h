@@ -152,6 +152,7 @@ typedef struct LightView {
     int num_face_planes;
     double face_plane[6][4];  /* the frustum's planes, inward normals: n.p + d >= 0 inside */
     int face_of_plane[6];     /* map face of each light-facing plane, -1 for the others */
+    bool directional;         /* the light's rays are parallel, along light_dir */
     dvec3 light_dir;          /* directional: travel direction; else unused (rays from origin_world) */
 } LightView;
 

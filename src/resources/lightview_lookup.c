@@ -52,8 +52,30 @@ static int cascade_by_projection(const LightView *lv, dvec3 p)
     return cascade_by_depth(lv, p);
 }
 
+/* Frustum-face partitions: the light-facing face the point's ray toward the
+ * light leaves the frustum through (the nearest such plane along the ray). */
+static int face_by_exit(const LightView *lv, dvec3 p)
+{
+    dvec3 dir = lv->directional ? d3_scale(lv->light_dir, -1)
+                                : d3_normalize_or(d3_sub(lv->origin_world, p), d3_scale(lv->light_dir, -1));
+    int best = 0;
+    double t_best = INFINITY;
+    for (int k = 0; k < lv->num_face_planes; k++) {
+        const double *pl = lv->face_plane[k];
+        double rate = pl[0] * dir.x + pl[1] * dir.y + pl[2] * dir.z; /* < 0: moving outward */
+        if (lv->face_of_plane[k] < 0 || !(rate < 0.0)) continue;
+        double t = (pl[0] * p.x + pl[1] * p.y + pl[2] * p.z + pl[3]) / -rate;
+        if (t < t_best) {
+            t_best = t;
+            best = lv->face_of_plane[k];
+        }
+    }
+    return best;
+}
+
 static int choose_face(const LightView *lv, dvec3 p)
 {
+    if (lv->face_partition) return face_by_exit(lv, p);
     if (lv->num_cascades > 1)
         return lv->select == CASCADE_BY_PROJECTION ? cascade_by_projection(lv, p) : cascade_by_depth(lv, p);
     dvec3 d = d3_sub(p, lv->origin_world);

@@ -109,7 +109,12 @@ static void frame_axis(const MapFace *f, const WarpSetup *w, Frame *fr)
 {
     double xa, ya, za, xb, yb, zb;
     dvec3 pa = d3_madd(w->view->eye, w->view->fwd, w->z_min), pb = d3_madd(w->view->eye, w->view->fwd, w->z_max);
-    fr->gamma = asin(fmin(1.0, d3_len(d3_cross(w->view->fwd, w->light_axis))));
+    if (w->has_axis) {
+        pa = w->axis_from;
+        pb = w->axis_to;
+    }
+    dvec3 dir = d3_normalize_or(d3_sub(pb, pa), w->view->fwd);
+    fr->gamma = asin(fmin(1.0, d3_len(d3_cross(dir, w->light_axis))));
     fr->axis_ok = false;
     fr->a[0] = 0.0; fr->a[1] = 1.0;
     if (lightview_base_ndc(f, pa, &xa, &ya, &za) && lightview_base_ndc(f, pb, &xb, &yb, &zb)) {

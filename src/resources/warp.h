@@ -21,6 +21,10 @@ typedef struct WarpSetup {
     const dvec3 *pts;               /* what the face must cover (world) */
     int n;
     double z_min, z_max;            /* their view-depth range (world units), within the camera's */
+    /* The warp's axis: the image of the view axis, or of the segment
+     * axis_from -> axis_to when has_axis (a frustum face's, course §3.2.3.2). */
+    bool has_axis;
+    dvec3 axis_from, axis_to;
 } WarpSetup;
 
 /* Turn the fitted base face f into the warped face (res: texels per side,

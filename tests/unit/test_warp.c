@@ -51,12 +51,9 @@ typedef struct AxisError { double e_x, e_y; int face; } AxisError;
 static bool axis_error(const Scene *sc, const ShadowMap *m, double z, AxisError *out)
 {
     AliasingView av = aliasing_view(&sc->camera);
-    dvec3 p = d3_madd(av.frustum.eye, av.frustum.fwd, z), to_light = aliasing_to_light(&sc->lights[0], p);
-    dvec3 n = d3_normalize_or(d3_add(d3_scale(av.frustum.fwd, -1), to_light), to_light);
     AliasingPoint pt;
-    if (!aliasing_at(&m->view, &av, p, n, to_light, &pt)) return false;
-    out->e_y = pt.m_t * m->res * av.pixel;           /* image-plane units per map height */
-    out->e_x = pt.m_s * m->res / sc->camera.width;   /* viewport widths per map width */
+    if (!aliasing_on_axis(&m->view, &av, &sc->lights[0], z, &pt)) return false;
+    aliasing_normalised(&av, m->res, &pt, &out->e_x, &out->e_y);
     out->face = pt.face;
     return true;
 }
@@ -239,4 +236,39 @@ TEST(test_warp_stabilized_texels_stay_put_when_the_camera_moves)
     CHECK_NEAR(origin[0][0], origin[1][0], 1e-6);
     CHECK_NEAR(origin[0][1], origin[1][1], 1e-6);
     CHECK(fabs(origin_free[0][0] - origin_free[1][0]) + fabs(origin_free[0][1] - origin_free[1][1]) > 1e-3);
+}
+
+/* Course §3.2.3.2: under an overhead light only the top face of the view
+ * frustum faces the light, so frustum-face partitioning is one warped map,
+ * LiSPSM itself; with the light behind the viewer the near face and the
+ * side faces each get a map, and every point of the frustum finds one. */
+TEST(test_warp_frustum_faces_overhead_is_warping_behind_is_several_maps)
+{
+    Lab *lab = open_plane();
+    CHECK(lab);
+    const char *fp[] = {"fit=body", "map_size=1024", "projection=lispsm", "split_scheme=faces"};
+    const char *w[] = {"fit=body", "map_size=1024", "projection=lispsm"};
+    const ShadowMap *a = map_with(lab, fp, 4), *b = map_with(lab, w, 3);
+    CHECK(a && b && a->num_faces == 1);
+    AliasingSummary sa, sb;
+    const Scene *sc = lab_scene(lab);
+    aliasing_frustum(&a->view, sc, &sc->lights[0], 12, 12, 12, &sa);
+    aliasing_frustum(&b->view, sc, &sc->lights[0], 12, 12, 12, &sb);
+    printf("    overhead: faces %d, storage factor %.2f (lispsm %.2f)\n", a->num_faces, sa.storage, sb.storage);
+    CHECK_NEAR(sa.storage, sb.storage, 1e-6 * sb.storage);
+    lab_close(lab);
+    Error err;
+    const char *ov[] = {"lights[1].direction={0.1,-0.4,-1}"};
+    lab = lab_open("scenes/overhead-plane.lua", ov, 1, &err);
+    CHECK(lab);
+    a = map_with(lab, fp, 4);
+    CHECK(a && a->num_faces >= 3);
+    sc = lab_scene(lab);
+    aliasing_frustum(&a->view, sc, &sc->lights[0], 12, 12, 12, &sa);
+    long per_face = 0;
+    for (int f = 0; f < a->num_faces; f++) per_face += sa.face_count[f] > 0;
+    printf("    light behind: %d faces, %ld of them used, %ld frustum points measured\n", a->num_faces, per_face,
+           sa.measured);
+    CHECK(per_face >= 3 && sa.measured > 0);
+    lab_close(lab);
 }
