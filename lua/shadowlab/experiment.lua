@@ -1,8 +1,10 @@
 -- experiment.lua -- running a sweep: the configurations (scene variants x
 -- techniques x parameter points, from the registry), a stable key for each
 -- (the engine's hash of the scene's content, light, technique and every
--- parameter value), one Lab per scene variant so resources are reused across
--- its configurations, a warm-up and N timed repeats per configuration, and
+-- parameter value), one Lab per scene variant so a technique's resources are
+-- reused across its parameter points (and dropped before the next technique,
+-- so memory stays bounded), a warm-up and N timed repeats per configuration
+-- (stopping early past a time budget), and
 -- one record row each, appended durably (records.lua). --resume skips keys
 -- already recorded; --shard I/N runs the configurations whose index modulo N
 -- is I into their own files, for `shadowlab merge`.
@@ -14,11 +16,14 @@ local experiment = {}
 local Experiment = {}
 Experiment.__index = Experiment
 
+-- time_budget_s: the timed repeats of a configuration stop once they took
+-- this long (at least one runs; lab.h RenderTiming), so a slow technique
+-- does not hold a sweep up for `repeats` long evaluations; 0: no limit.
 local defaults = { samples = 256, pattern = "r2", seed = 1, light = 1, repeats = 3, warmup = 1, images = true,
-                   exr = false }
+                   exr = false, time_budget_s = 1 }
 local spec_fields = { name = true, scenes = true, overrides = true, samples = true, pattern = true, seed = true,
                       light = true, repeats = true, warmup = true, images = true, exr = true, cache = true,
-                      description = true }
+                      description = true, time_budget_s = true }
 
 local function merged(a, b)
   local m = {}
@@ -111,11 +116,22 @@ experiment options:
   --repeats N      timed evaluations per configuration (median and minimum recorded)
   --warmup N       untimed evaluations before them
   --samples N      reference light samples per view sample
+  -s, --set K=V    scene override for every scene, e.g. --set camera.width=160 (repeatable)
   --no-images      no PNG images per configuration (smaller, faster; the report shows plots only)
   --quiet          no progress lines]]
 
-local function usage_error(msg)
-  io.stderr:write("error: ", msg, "\n", usage, "\n")
+local function extra_usage(extra)
+  local names, lines = {}, {}
+  for name in pairs(extra or {}) do names[#names + 1] = name end
+  table.sort(names)
+  for _, name in ipairs(names) do
+    lines[#lines + 1] = string.format("  --%-14s %s (default %s)", name .. " V", extra[name].help, extra[name].default)
+  end
+  return #lines > 0 and "\nthis script's options:\n" .. table.concat(lines, "\n") or ""
+end
+
+local function usage_error(msg, extra)
+  io.stderr:write("error: ", msg, "\n", usage, extra_usage(extra), "\n")
   os.exit(2)
 end
 
@@ -125,9 +141,19 @@ local function int_arg(argv, i, name, lo, hi)
   return v
 end
 
+-- "160" -> 160, "0.3" -> 0.3, "true"/"false" -> booleans, else the text.
+local function override_value(text)
+  if text == "true" or text == "false" then return text == "true" end
+  local n = tonumber(text)
+  return n and (math.tointeger(n) or n) or text
+end
+
 -- Parse the script's arguments (arg); bad ones print usage and exit 2.
-function experiment.parse_args(argv)
-  local o, i = { shard = { index = 0, count = 1 } }, 1
+-- `extra` declares the script's own options, {name = {default =, help =}}:
+-- their values (strings) are in o.extra. Pass the result to exp:run.
+function experiment.parse_args(argv, extra)
+  local o, i = { shard = { index = 0, count = 1 }, set = {}, extra = {}, parsed = true }, 1
+  for name, spec in pairs(extra or {}) do o.extra[name] = spec.default end
   while argv and argv[i] do
     local a = argv[i]
     if a == "--out" then o.out = argv[i + 1] or usage_error("--out expects a folder"); i = i + 1
@@ -135,6 +161,11 @@ function experiment.parse_args(argv)
     elseif a == "--fresh" then o.fresh = true
     elseif a == "--no-images" then o.images = false
     elseif a == "--quiet" then o.quiet = true
+    elseif a == "--set" or a == "-s" then
+      local k, v = (argv[i + 1] or ""):match("^([^=]+)=(.+)$")
+      if not k then usage_error(a .. " expects KEY=VALUE, e.g. camera.width=160") end
+      o.set[k] = override_value(v)
+      i = i + 1
     elseif a == "--shard" then
       local si, sn = (argv[i + 1] or ""):match("^(%d+)/(%d+)$")
       si, sn = math.tointeger(tonumber(si)), math.tointeger(tonumber(sn))
@@ -145,8 +176,11 @@ function experiment.parse_args(argv)
     elseif a == "--repeats" then o.repeats = int_arg(argv, i, a, 1, 10000); i = i + 1
     elseif a == "--warmup" then o.warmup = int_arg(argv, i, a, 0, 1000); i = i + 1
     elseif a == "--samples" then o.samples = int_arg(argv, i, a, 1, 1048576); i = i + 1
-    elseif a == "--help" or a == "-h" then io.stdout:write(usage, "\n"); os.exit(0)
-    else usage_error("unknown argument '" .. tostring(a) .. "'") end
+    elseif a == "--help" or a == "-h" then io.stdout:write(usage, extra_usage(extra), "\n"); os.exit(0)
+    elseif extra and extra[a:match("^%-%-(.+)$") or ""] then
+      o.extra[a:sub(3)] = argv[i + 1] or usage_error(a .. " expects a value", extra)
+      i = i + 1
+    else usage_error("unknown argument '" .. tostring(a) .. "'", extra) end
     i = i + 1
   end
   if o.resume and o.fresh then usage_error("--resume and --fresh exclude each other") end
@@ -190,7 +224,8 @@ end
 
 function Experiment:settings()
   return { samples = self.samples, pattern = self.pattern, seed = self.seed, light = self.light,
-           repeats = self.repeats, warmup = self.warmup, measure = "visibility" }
+           repeats = self.repeats, warmup = self.warmup, time_budget_s = self.time_budget_s, measure = "visibility",
+           overrides = self.overrides }
 end
 
 -- The CSV columns: the standard ones, then every parameter of the
@@ -253,7 +288,7 @@ end
 function Experiment:compare_options(config, out_dir)
   return { technique = config.entry.technique.name, params = config.entry.params, light = self.light,
            repeats = self.repeats, warmup = self.warmup, samples = self.samples, pattern = self.pattern,
-           seed = self.seed, cache = self.cache, out = out_dir, exr = self.exr }
+           seed = self.seed, cache = self.cache, out = out_dir, exr = self.exr, time_budget = self.time_budget_s }
 end
 
 -- The reference's images for a variant, once per results folder.
@@ -280,7 +315,7 @@ function Experiment:run_one(config, o, header)
     row.status, row.record = "ok", run:record()
     if paths then row.images = paths; row.images.dir = nil end
   else
-    row.status, row.error = "error", tostring(run)
+    row.status, row.error = "error", (tostring(run):gsub("^[^:\n]*experiment%.lua:%d+: ", ""))
   end
   return row
 end
@@ -299,17 +334,22 @@ local function progress(o, n, total, config, row)
                                 row.record.resource_cache))
 end
 
--- Run the experiment with the script's arguments. Returns a result table:
+-- Run the experiment with the script's arguments (arg, or parse_args's
+-- result). Returns a result table:
 -- rows (this output's rows in configuration order), out, sharded, computed,
 -- skipped, failed, the experiment and its header.
 function Experiment:run(argv)
-  local o = experiment.parse_args(argv)
+  local o = (type(argv) == "table" and argv.parsed) and argv or experiment.parse_args(argv)
   o.out = o.out or ("reports/" .. self.name)
   if o.images == nil then o.images = self.images end
   for _, k in ipairs({ "repeats", "warmup", "samples" }) do
     if o[k] then self[k] = o[k] end
   end
   if o.threads then sl.threads(o.threads) end
+  for k, v in pairs(o.set) do
+    self.overrides[k] = v
+    for _, variant in ipairs(self.variants) do variant.overrides[k] = v end
+  end
   if #self.entries == 0 then error("experiment " .. self.name .. ": no techniques added", 0) end
   if #self.variants == 0 then error("experiment " .. self.name .. ": no scenes", 0) end
   local configs = self:configurations()
@@ -324,8 +364,11 @@ function Experiment:run(argv)
   for _, c in ipairs(configs) do
     if c.index % o.shard.count == o.shard.index then mine[#mine + 1] = c end
   end
-  local last_use = {}
-  for i, c in ipairs(mine) do last_use[c.variant] = i end
+  local last_use, last_of_entry = {}, {}
+  for i, c in ipairs(mine) do
+    last_use[c.variant] = i
+    last_of_entry[c.variant_index .. "/" .. c.entry.technique.name] = i
+  end
   for i, c in ipairs(mine) do
     local row = writer.done[c.key]
     if row then
@@ -342,6 +385,8 @@ function Experiment:run(argv)
     if last_use[c.variant] == i then
       c.variant.lab:close()
       c.variant.lab = nil
+    elseif last_of_entry[c.variant_index .. "/" .. c.entry.technique.name] == i then
+      c.variant.lab:drop_resources() -- the next technique shares little: memory stays bounded
     end
   end
   writer:close()

@@ -138,9 +138,10 @@ function html.write_index(path, doc)
   out[#out + 1] = '<p id="load-status">checking images…</p>'
   out[#out + 1] = string.format("<p>Experiment <code>%s</code> (fingerprint %s): %d configurations, %d failed. " ..
                                 "Reference: %d %s light samples, seed %d, light %d. Timing: %d warm-up + %d " ..
-                                "timed evaluations. Machine: %s.</p>", esc(h.name), esc(h.fingerprint),
-                                #doc.rows, #doc.rows - #doc.ok_rows, s.samples, esc(s.pattern), s.seed, s.light,
-                                s.warmup, s.repeats, machine_text(doc))
+                                "timed evaluations, the timed ones stopping after %g s. Machine: %s.</p>",
+                                esc(h.name), esc(h.fingerprint), #doc.rows, #doc.rows - #doc.ok_rows, s.samples,
+                                esc(s.pattern), s.seed, s.light, s.warmup, s.repeats, s.time_budget_s or 0,
+                                machine_text(doc))
   out[#out + 1] = '<p>Data: <a href="results.csv">results.csv</a> · <a href="records.jsonl">records.jsonl</a> ' ..
                   "(one JSON record per configuration, with every parameter, timing and resource).</p>"
   out[#out + 1] = definitions

@@ -1,8 +1,9 @@
 -- plot.lua -- one gnuplot plot in SVG and PNG: the data (NAME.dat, one block
 -- per series), the script (NAME.gp, kept so a figure can be restyled and
 -- redrawn by hand), and the two images. Series styles: "points",
--- "linespoints", "front" (a Pareto staircase, black); `hline` draws a dashed
--- horizontal line (the reference's noise).
+-- "linespoints", "lines" (analytic curves), "front" (a Pareto staircase,
+-- black); `hline` draws a dashed horizontal line (the reference's noise);
+-- `logx`, `logy` log scales.
 local sl = package.loaded.shadowlab or require "shadowlab"
 
 local plot = {}
@@ -20,14 +21,24 @@ local function data_text(series)
   return table.concat(blocks, "\n\n\n") .. "\n"
 end
 
+-- Distinct colour and marker pairs for many series (12 colours x 13 markers).
+local colours = { "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
+                  "#7f7f7f", "#bcbd22", "#000080", "#008080" }
+local markers = { 5, 7, 9, 11, 13, 4, 6, 8, 10, 12, 1, 2, 3 }
+
+local function look(i)
+  return string.format('pt %d lc rgb "%s"', markers[(i - 1) % #markers + 1], colours[(i - 1) % #colours + 1])
+end
+
 local function plot_clause(data, i, s)
   local style
   if s.style == "front" then
     return string.format('%s index %d using 1:2 with steps lw 2 lc rgb "black" title %s, ' ..
                          '%s index %d using 1:2 with points pt 6 ps 2.4 lc rgb "black" notitle',
                          quoted(data), i - 1, quoted(s.title), quoted(data), i - 1)
-  elseif s.style == "linespoints" then style = string.format("with linespoints pt %d ps 1.1 lw 1.5", 4 + i)
-  else style = string.format("with points pt %d ps 1.3", 4 + i) end
+  elseif s.style == "linespoints" then style = "with linespoints ps 1.1 lw 1.5 " .. look(i)
+  elseif s.style == "lines" then style = "with lines lw 2 " .. look(i)
+  else style = "with points ps 1.3 " .. look(i) end
   return string.format("%s index %d using 1:2 %s title %s", quoted(data), i - 1, style, quoted(s.title))
 end
 
@@ -42,7 +53,8 @@ local function script_text(name, spec)
   for _, s in ipairs(spec.series) do
     for _, p in ipairs(s.points) do ymax = math.max(ymax, p[2]) end
   end
-  lines[#lines + 1] = ymax > 0 and string.format("set yrange [0:%.9g]", 1.08 * ymax) or "set yrange [0:*]"
+  if spec.logy then lines[#lines + 1] = "set logscale y"
+  else lines[#lines + 1] = ymax > 0 and string.format("set yrange [0:%.9g]", 1.08 * ymax) or "set yrange [0:*]" end
   if spec.logx then lines[#lines + 1] = "set logscale x" end
   if spec.hline then
     lines[#lines + 1] = string.format('set arrow from graph 0, first %.9g to graph 1, first %.9g nohead dt 2 lc rgb "gray40"',

@@ -41,7 +41,7 @@ static bool setup(Job *j, int stages, Error *err)
 {
     const CliOptions *o = &j->o;
     j->req = (CompareRequest){NULL, j->params, 0, o->repeat, o->warmup, (stages & STAGE_REFERENCE) != 0, o->ref,
-                              NULL};
+                              NULL, 0.0};
     if (!(stages & STAGE_RENDER)) return reference_params_check(&o->ref, err);
     if (!o->technique) return error_set(err, "missing -t TECHNIQUE (see shadowlab list)");
     j->req.tech = tech_find(o->technique, err);

@@ -23,7 +23,8 @@ static bool run_stages(Lab *lab, const CompareRequest *req, CompareResult *out, 
 {
     if (req->tech) {
         RenderRequest rr = {req->tech, req->params, req->light_index, req->repeat};
-        if (!lab_render_warm(lab, &rr, req->warmup, &out->render, err)) return false;
+        RenderTiming timing = {req->warmup, req->time_budget_s};
+        if (!lab_render_timed(lab, &rr, &timing, &out->render, err)) return false;
     }
     if (req->reference) {
         RefRequest rq = {req->light_index, req->ref, req->cache_dir};

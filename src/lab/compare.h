@@ -16,6 +16,7 @@ typedef struct CompareRequest {
     bool reference;         /* compute or load the reference; with tech, also the metrics */
     ReferenceParams ref;
     const char *cache_dir;  /* NULL: no disk cache */
+    double time_budget_s;   /* > 0: stop timed repeats after this long (lab.h RenderTiming) */
 } CompareRequest;
 
 typedef struct CompareResult {

@@ -87,17 +87,30 @@ static void finish_image(Image *img, int tech_channels, const uint8_t *cls)
     }
 }
 
-static bool run_evaluations(const RenderRequest *req, int warmup, const void *state, const TechContext *ctx,
-                            RenderResult *out)
+/* Warm-ups, then timed repeats (see RenderTiming); sets repeat and warmup to
+ * the counts that ran. */
+static bool run_evaluations(const RenderRequest *req, const RenderTiming *timing, const void *state,
+                            const TechContext *ctx, RenderResult *out)
 {
     double *times = malloc(sizeof(double) * (size_t)req->repeat);
     if (!times) return false;
-    for (int i = 0; i < warmup; i++) evaluate_all(req->tech, state, ctx, &out->visibility);
-    for (int i = 0; i < req->repeat; i++) times[i] = evaluate_all(req->tech, state, ctx, &out->visibility);
-    qsort(times, (size_t)req->repeat, sizeof(double), cmp_double);
+    int n = 0;
+    double total = 0;
+    for (out->warmup = 0; out->warmup < timing->warmup; out->warmup++) {
+        double t = evaluate_all(req->tech, state, ctx, &out->visibility);
+        if (timing->budget_s > 0 && t >= timing->budget_s) {
+            times[n++] = total = t; /* long enough that caches cannot matter: it is the timed one */
+            break;
+        }
+    }
+    while (n < req->repeat && (n == 0 || timing->budget_s <= 0 || total < timing->budget_s)) {
+        times[n] = evaluate_all(req->tech, state, ctx, &out->visibility);
+        total += times[n++];
+    }
+    qsort(times, (size_t)n, sizeof(double), cmp_double);
+    out->repeat = n;
     out->eval_min_s = times[0];
-    out->eval_median_s = req->repeat % 2 ? times[req->repeat / 2]
-                                         : 0.5 * (times[req->repeat / 2 - 1] + times[req->repeat / 2]);
+    out->eval_median_s = n % 2 ? times[n / 2] : 0.5 * (times[n / 2 - 1] + times[n / 2]);
     free(times);
     return true;
 }
@@ -118,15 +131,19 @@ static double collect_tech_resources(const ResourceManager *rm, RenderResult *ou
 
 bool lab_render(Lab *lab, const RenderRequest *req, RenderResult *out, Error *err)
 {
-    return lab_render_warm(lab, req, 0, out, err);
+    RenderTiming untimed_warmup_none = {0, 0.0};
+    return lab_render_timed(lab, req, &untimed_warmup_none, out, err);
 }
 
-bool lab_render_warm(Lab *lab, const RenderRequest *req, int warmup, RenderResult *out, Error *err)
+bool lab_render_timed(Lab *lab, const RenderRequest *req, const RenderTiming *timing, RenderResult *out, Error *err)
 {
     memset(out, 0, sizeof *out);
     const Scene *sc = &lab->scene;
     if (req->repeat < 1 || req->repeat > 10000) return error_set(err, "--repeat %d outside [1, 10000]", req->repeat);
-    if (warmup < 0 || warmup > 1000) return error_set(err, "--warmup %d outside [0, 1000]", warmup);
+    if (timing->warmup < 0 || timing->warmup > 1000)
+        return error_set(err, "--warmup %d outside [0, 1000]", timing->warmup);
+    if (!(timing->budget_s >= 0 && timing->budget_s <= 1e6))
+        return error_set(err, "time budget %g s outside [0, 1e6]", timing->budget_s);
     if (!tech_check_light(req->tech, &sc->lights[req->light_index], req->light_index + 1, err)) return false;
     double t0 = timer_now_s();
     const ViewSamples *vs = res_view_samples(lab->rm, sc, err);
@@ -157,9 +174,7 @@ bool lab_render_warm(Lab *lab, const RenderRequest *req, int warmup, RenderResul
     }
     double built_s;
     out->tech_build_s = collect_tech_resources(lab->rm, out, &built_s);
-    out->repeat = req->repeat;
-    out->warmup = warmup;
-    bool ok = run_evaluations(req, warmup, state, &ctx, out);
+    bool ok = run_evaluations(req, timing, state, &ctx, out);
     out->frame_s = out->tech_build_s + fmax(0.0, out->prepare_s - built_s) + out->eval_median_s;
     if (req->tech->release) req->tech->release(state);
     if (!ok) {

@@ -52,8 +52,16 @@ typedef struct RenderResult {
 } RenderResult;
 
 bool lab_render(Lab *lab, const RenderRequest *req, RenderResult *out, Error *err);
-/* The same after `warmup` untimed evaluations (caches, page faults), in [0, 1000]. */
-bool lab_render_warm(Lab *lab, const RenderRequest *req, int warmup, RenderResult *out, Error *err);
+/* How evaluations are timed: `warmup` untimed ones first (caches, page
+ * faults), in [0, 1000]; with budget_s > 0 the timed repeats stop once they
+ * have taken budget_s seconds (at least one runs), and a warm-up that alone
+ * takes budget_s counts as the one timed evaluation (caches cannot matter at
+ * that length). RenderResult's repeat and warmup say how many ran. */
+typedef struct RenderTiming {
+    int warmup;
+    double budget_s; /* 0: exactly req->repeat timed evaluations */
+} RenderTiming;
+bool lab_render_timed(Lab *lab, const RenderRequest *req, const RenderTiming *timing, RenderResult *out, Error *err);
 void render_result_free(RenderResult *r);
 
 #endif

@@ -124,7 +124,8 @@ int sl_lab_open(lua_State *L)
 /* ---- options ------------------------------------------------------------ */
 
 static const char *const option_names[] = {"technique", "params", "light", "repeats", "warmup", "samples", "pattern",
-                                           "seed", "measure", "cache", "out", "png", "exr", "print", NULL};
+                                           "seed", "measure", "cache", "out", "png", "exr", "print",
+                                           "time_budget", NULL};
 
 static void check_option_names(lua_State *L, int idx, const char *method)
 {
@@ -153,6 +154,17 @@ static int opt_int(lua_State *L, int idx, const char *name, int def, int lo, int
     if (v < lo || v > hi) luaL_error(L, "option %s = %d outside [%d, %d]", name, (int)v, lo, hi);
     lua_pop(L, 1);
     return (int)v;
+}
+
+static double opt_number(lua_State *L, int idx, const char *name, double def, double lo, double hi)
+{
+    lua_getfield(L, idx, name);
+    int isnum = 0;
+    double v = lua_isnil(L, -1) ? def : lua_tonumberx(L, -1, &isnum);
+    if (!lua_isnil(L, -1) && !isnum) luaL_error(L, "option %s must be a number in [%g, %g]", name, lo, hi);
+    if (!(v >= lo && v <= hi)) luaL_error(L, "option %s = %g outside [%g, %g]", name, v, lo, hi);
+    lua_pop(L, 1);
+    return v;
 }
 
 static bool opt_bool(lua_State *L, int idx, const char *name, bool def)
@@ -224,6 +236,7 @@ static void read_options(lua_State *L, Lab *lab, const char *method, bool render
         o->req.params = o->params;
         o->req.repeat = opt_int(L, idx, "repeats", 1, 1, 10000);
         o->req.warmup = opt_int(L, idx, "warmup", 0, 0, 1000);
+        o->req.time_budget_s = opt_number(L, idx, "time_budget", 0.0, 0.0, 1e6);
     }
     o->req.reference = reference;
     read_reference_options(L, idx, o);
@@ -335,6 +348,13 @@ static int lab_info_m(lua_State *L)
     return 1;
 }
 
+/* lab:drop_resources(): free everything the Lab built (the scene stays). */
+static int lab_drop_m(lua_State *L)
+{
+    rm_clear(lab_resources(check_lab(L)));
+    return 0;
+}
+
 static int lab_close_m(lua_State *L)
 {
     LuaLab *ll = luaL_checkudata(L, 1, SL_LAB_TYPE);
@@ -356,6 +376,7 @@ void sl_register_lab(lua_State *L)
     static const luaL_Reg methods[] = {
         {"render", lab_render_m}, {"reference", lab_reference_m}, {"compare", lab_compare_m},
         {"key", lab_key_m},       {"info", lab_info_m},           {"close", lab_close_m},
+        {"drop_resources", lab_drop_m},
         {NULL, NULL},
     };
     static const luaL_Reg meta[] = {

@@ -42,13 +42,21 @@ struct ResourceManager {
 
 ResourceManager *rm_create(void) { return calloc(1, sizeof(ResourceManager)); }
 
-void rm_destroy(ResourceManager *rm)
+void rm_clear(ResourceManager *rm)
 {
-    if (!rm) return;
     for (int i = rm->count - 1; i >= 0; i--) {
         rm->entries[i].kind->destroy(rm->entries[i].res);
         free(rm->entries[i].deps.v);
     }
+    rm->count = 0;
+    rm->log.n = 0;
+    rm->scope.n = 0;
+}
+
+void rm_destroy(ResourceManager *rm)
+{
+    if (!rm) return;
+    rm_clear(rm);
     for (int d = 0; d < RM_MAX_DEPTH; d++) free(rm->frames[d].deps.v);
     free(rm->entries);
     free(rm->log.ev);

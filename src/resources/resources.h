@@ -37,6 +37,9 @@ typedef struct ResourceManager ResourceManager;
 
 ResourceManager *rm_create(void);
 void rm_destroy(ResourceManager *rm);
+/* Destroy every resource (and the log): later requests build afresh. A
+ * sweep calls it between techniques that share nothing, to bound memory. */
+void rm_clear(ResourceManager *rm);
 
 /* Find or build the resource (kind, key). `desc` describes the key for the
  * log. Thread-compatible, not thread-safe: acquire from one thread. */

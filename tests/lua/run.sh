@@ -2,8 +2,10 @@
 # run.sh -- the Lua lab's tests: the helpers' unit tests, the module from a
 # plain lua5.4, exit statuses and bad parameters, a sweep killed with SIGKILL
 # and resumed, the same sweep as 2 shards through GNU Parallel (and the Slurm
-# script) merged and compared with the unsharded run, merge refusals, and the
-# report opened in headless Chromium. Usage: tests/lua/run.sh build/shadowlab.
+# script) merged and compared with the unsharded run, merge refusals, the
+# shipped experiments at tiny sizes (error-vs-time's plot shows every
+# registered technique), and the report opened in headless Chromium.
+# Usage: tests/lua/run.sh build/shadowlab.
 # Prints "lua: N passed, N failed".
 set -u
 SL=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
@@ -136,6 +138,16 @@ expect merge_refuses_mismatched_experiments 1 "refusing to merge different exper
 expect merge_refuses_to_overwrite 1 "--force" -- "$SL" merge -o "$PAR" "$PAR/shards/0" "$PAR/shards/1"
 expect resume_refuses_another_experiment 1 "fingerprint" "--fresh" -- \
     "$SL" run "$SWEEP" --out "$FULL" --resume --samples 8 --quiet
+
+# ---- the shipped experiments at tiny settings (the default runs are the README's)
+TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeats 1 --warmup 0 --no-images"
+expect error_vs_time_runs 0 "report:" -- "$SL" run experiments/error-vs-time.lua --factors 1 $TINY --out "$TMP/evt"
+expect error_vs_time_plot_shows_every_registered_technique 0 "registered techniques" -- \
+    "$SL" run tests/lua/every-technique.lua "$TMP/evt"
+expect lab_kernel_size_runs 0 "0 failed" "report:" -- \
+    "$SL" run experiments/lab-kernel-size.lua --techniques pcf $TINY --out "$TMP/lks"
+expect lab_light_radius_runs_a_shard 0 "0 failed" -- \
+    "$SL" run experiments/lab-light-radius.lua $TINY --shard 0/24 --out "$TMP/llr"
 
 # ---- the report in headless Chromium: every image and plot loads, nothing logged
 browse() { # browse DIR: DOM after load in $TMP/dom.html, browser log in $TMP/browser.log

@@ -2,7 +2,8 @@
  * a stage depends on, also when it reuses a resource whose dependencies it
  * never asks for again, and the own build times of those resources add up to
  * the cost of building them from nothing; a technique's frame time (lab.h)
- * is the same whether its resources were built in this run or reused. */
+ * is the same whether its resources were built in this run or reused; a time
+ * budget stops the timed repeats and the result says how many ran. */
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -99,7 +100,7 @@ TEST(test_frame_time_counts_reused_technique_resources)
     CHECK(hard);
     double params[TECH_MAX_PARAMS];
     tech_params_default(hard, params);
-    CompareRequest rq = {hard, params, 0, 2, 1, false, {MEASURE_VISIBILITY, 16, SAMPLING_R2, 1}, NULL};
+    CompareRequest rq = {hard, params, 0, 2, 1, false, {MEASURE_VISIBILITY, 16, SAMPLING_R2, 1}, NULL, 0.0};
     CompareResult first, second;
     CHECK(lab_compare(lab, &rq, &first, &err));
     CHECK(lab_compare(lab, &rq, &second, &err));
@@ -131,5 +132,29 @@ TEST(test_config_key_depends_on_every_parameter)
     CHECK(lab_config_key(lab, hard, a, 0) == lab_config_key(lab, hard, b, 0));
     b[0] = 2.0;
     CHECK(lab_config_key(lab, hard, a, 0) != lab_config_key(lab, hard, b, 0));
+    lab_close(lab);
+}
+
+TEST(test_time_budget_stops_timed_repeats_and_says_how_many_ran)
+{
+    Error err;
+    Lab *lab = fixture_lab("budget.lua", scope_scene);
+    CHECK(lab);
+    const Technique *hard = tech_find("hard", &err);
+    double params[TECH_MAX_PARAMS];
+    tech_params_default(hard, params);
+    RenderRequest rq = {hard, params, 0, 5};
+    RenderResult unlimited, tiny;
+    RenderTiming none = {1, 0.0}, budget = {1, 1e-9};
+    CHECK(lab_render_timed(lab, &rq, &none, &unlimited, &err));
+    CHECK(unlimited.repeat == 5 && unlimited.warmup == 1);
+    /* every evaluation takes longer than 1 ns: the warm-up is the one timed evaluation */
+    CHECK(lab_render_timed(lab, &rq, &budget, &tiny, &err));
+    CHECK_MSG(tiny.repeat == 1 && tiny.warmup == 0, "repeat %d warmup %d", tiny.repeat, tiny.warmup);
+    CHECK(tiny.eval_min_s == tiny.eval_median_s);
+    render_result_free(&unlimited);
+    render_result_free(&tiny);
+    RenderTiming negative = {1, -1.0};
+    CHECK(!lab_render_timed(lab, &rq, &negative, &tiny, &err) && strstr(err.msg, "budget"));
     lab_close(lab);
 }
