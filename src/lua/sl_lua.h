@@ -38,8 +38,6 @@ int sl_lab_open(lua_State *L);
 void sl_register_lab(lua_State *L);
 /* The open Lab of the userdata at idx (raises on a closed one). */
 Lab *sl_check_lab(lua_State *L, int idx);
-/* The open Lab of the userdata at idx (raises on a closed one). */
-Lab *sl_check_lab(lua_State *L, int idx);
 /* laliasing.c: lab:aliasing{...}, added to the Lab's methods. */
 void sl_register_aliasing(lua_State *L);
 
