@@ -22,6 +22,10 @@ static size_t sw_bytes(const void *r)
 
 static const ResourceKind kind_shadow_width = {"shadow_width_map", sw_bytes, sw_destroy};
 
+/* The minimum as a plain select (no NaN rules: widths are finite), which
+ * compilers vectorise where fminf may stay a call. */
+static inline float min_f(float a, float b) { return b < a ? b : a; }
+
 typedef struct SwArgs {
     const ShadowMap *peeled;
     ShadowWidthSpec spec;
@@ -51,37 +55,40 @@ static int propagate_software(float *w, int res, float d)
 #pragma omp parallel for
     for (int j = 0; j < res; j++) {
         float *row = w + (size_t)j * res;
-        for (int i = 1; i < res; i++) row[i] = fminf(row[i], row[i - 1] + d);
-        for (int i = res - 2; i >= 0; i--) row[i] = fminf(row[i], row[i + 1] + d);
+        for (int i = 1; i < res; i++) row[i] = min_f(row[i], row[i - 1] + d);
+        for (int i = res - 2; i >= 0; i--) row[i] = min_f(row[i], row[i + 1] + d);
     }
     /* Columns in strips of SW_STRIP, each strip swept row by row (cache-friendly). */
 #pragma omp parallel for
     for (int i0 = 0; i0 < res; i0 += SW_STRIP) {
         int i1 = i0 + SW_STRIP < res ? i0 + SW_STRIP : res;
         for (int j = 1; j < res; j++)
-            for (int i = i0; i < i1; i++) w[(size_t)j * res + i] = fminf(w[(size_t)j * res + i], w[(size_t)(j - 1) * res + i] + d);
+            for (int i = i0; i < i1; i++) w[(size_t)j * res + i] = min_f(w[(size_t)j * res + i], w[(size_t)(j - 1) * res + i] + d);
         for (int j = res - 2; j >= 0; j--)
-            for (int i = i0; i < i1; i++) w[(size_t)j * res + i] = fminf(w[(size_t)j * res + i], w[(size_t)(j + 1) * res + i] + d);
+            for (int i = i0; i < i1; i++) w[(size_t)j * res + i] = min_f(w[(size_t)j * res + i], w[(size_t)(j + 1) * res + i] + d);
     }
     return 4;
 }
 
 /* One compositing pass: each texel takes the minimum of itself and its
- * neighbours at the offsets plus the difference d (textures clamp to the edge). */
+ * neighbours at the offsets plus the difference d (textures clamp to the
+ * edge). Row by row and offset by offset, so the inner loop is a plain
+ * vectorisable minimum over the columns whose neighbour lies inside. */
 static void doubling_pass(const float *src, float *dst, int res, const int (*off)[2], int n_off, float d)
 {
 #pragma omp parallel for
-    for (int j = 0; j < res; j++)
-        for (int i = 0; i < res; i++) {
-            float v = src[(size_t)j * res + i];
-            for (int k = 0; k < n_off; k++) {
-                int x = i + off[k][0], y = j + off[k][1];
-                x = x < 0 ? 0 : x >= res ? res - 1 : x;
-                y = y < 0 ? 0 : y >= res ? res - 1 : y;
-                v = fminf(v, src[(size_t)y * res + x] + d);
-            }
-            dst[(size_t)j * res + i] = v;
+    for (int j = 0; j < res; j++) {
+        float *out = dst + (size_t)j * res;
+        memcpy(out, src + (size_t)j * res, sizeof(float) * (size_t)res);
+        for (int k = 0; k < n_off; k++) {
+            int dx = off[k][0], y = j + off[k][1];
+            const float *row = src + (size_t)(y < 0 ? 0 : y >= res ? res - 1 : y) * res;
+            int lo = dx < 0 ? (-dx < res ? -dx : res) : 0, hi = dx > 0 ? (res - dx > 0 ? res - dx : 0) : res;
+            for (int i = 0; i < lo; i++) out[i] = min_f(out[i], row[0] + d);
+            for (int i = lo; i < hi; i++) out[i] = min_f(out[i], row[i + dx] + d);
+            for (int i = hi > lo ? hi : lo; i < res; i++) out[i] = min_f(out[i], row[res - 1] + d);
         }
+    }
 }
 
 /* Texture-compositing version (§4, Fig. 4): neighbours at 2^k texels in 3

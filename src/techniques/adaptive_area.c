@@ -1,8 +1,9 @@
 /* adaptive_area.c -- `adaptive_area`: Chun & Oh's soft shadow mapping for
  * rectangular lights of any shape and colour (seed 001 §3). A depth map from
  * the light's centre; per receiver the filter region is the cone from the
- * receiver to the light's four corners cut by the map's near plane, refined
- * to the plane of the average blocker depth found there; the region's mean
+ * receiver to the light's four corners cut at the nearest possible blocker
+ * (search_depth), refined to the plane of the average blocker depth found
+ * there; the region's mean
  * visibility E and variance V = E - E^2 (Eq. 1) decide a quad-tree split
  * (V above the threshold, or the light image's colour variance over that
  * part of the light above its own threshold, never in umbra or full light),
@@ -42,7 +43,8 @@ static const ParamDesc aa_params[] = {
     {"taps", PARAM_INT, 4, 1, AA_MAX_TAPS, "taps per side",
      "shadow tests per region and level: taps x taps points on a regular grid over the region", NULL},
     {"search_taps", PARAM_INT, 8, 1, AA_MAX_SEARCH_TAPS, "taps per side",
-     "blocker-search tests: search_taps x search_taps points over the cone's region on the near plane", NULL},
+     "blocker-search tests: search_taps x search_taps points over the cone's region at the nearest possible blocker",
+     NULL},
 };
 
 static const char *const aa_resources[] = {"shadow_map", "minmax_pyramid", "light_image_sat", "view_samples", NULL};
@@ -98,10 +100,10 @@ static bool light_axes(const TechContext *ctx, AaState *st, Error *err)
 {
     const LightView *lv = &st->map->view;
     const MapFace *f = &lv->face[0];
-    if (lv->num_faces != 1 || !f->perspective)
-        return error_set(err, "the filter region is the light's cone on one perspective map; projection %s gives "
-                              "%d %s face(s) (use auto or perspective)",
-                         map_projection_name(lv->projection), lv->num_faces, f->perspective ? "perspective" : "other");
+    if (lv->projection != MAP_PROJ_PERSPECTIVE || lv->num_faces != 1)
+        return error_set(err, "the filter region is the light's cone on one plain perspective map; projection %s "
+                              "gives %d face(s) (use auto or perspective, one cascade)",
+                         map_projection_name(lv->projection), lv->num_faces);
     const Light *l = ctx->light;
     dvec3 c = d3_from(l->position), right = d3_from(v3_cross(l->up, l->direction)), up = d3_from(l->up);
     dvec4 r_view = m4_apply(&f->view_from_world, d3_madd(c, right, l->width));
