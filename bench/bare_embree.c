@@ -15,6 +15,7 @@
 #include <string.h>
 #include <time.h>
 #include "core/fsutil.h"
+#include "core/machine.h"
 #include "core/timer.h"
 #include "lab/lab.h"
 #include "version.h"
@@ -242,23 +243,6 @@ static bool measure(const Inputs *in, const Options *o, Result *res, Error *err)
 
 /* ---- the record --------------------------------------------------------- */
 
-static void cpu_model(char *out, size_t n)
-{
-    snprintf(out, n, "unknown");
-    FILE *fp = fopen("/proc/cpuinfo", "r");
-    if (!fp) return;
-    char line[512];
-    while (fgets(line, sizeof line, fp)) {
-        char *colon = strchr(line, ':');
-        if (strncmp(line, "model name", 10) == 0 && colon) {
-            snprintf(out, n, "%s", colon + 2);
-            out[strcspn(out, "\n")] = '\0';
-            break;
-        }
-    }
-    fclose(fp);
-}
-
 /* A CSV field, quoted when it holds a comma, quote or newline. */
 static void csv_field(FILE *fp, const char *s)
 {
@@ -276,7 +260,7 @@ static void write_row(FILE *fp, const Inputs *in, const Options *o, const Result
     char cpu[256], date[32];
     time_t now = time(NULL);
     strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
-    cpu_model(cpu, sizeof cpu);
+    machine_cpu_model(cpu, sizeof cpu);
     csv_field(fp, in->scene->name);
     fprintf(fp, ",%d,%d,%d,%lld,%.0f,%.0f,%.4f,", in->scene->num_triangles, o->samples, o->threads, in->rays,
             in->rays / r->bare_s, in->rays / r->ref_s, r->ratio);

@@ -9,31 +9,15 @@
 #include "core/fsutil.h"
 #include "core/hash.h"
 #include "core/json.h"
+#include "core/machine.h"
 #include "lab/report.h"
 #include "version.h"
-
-static void cpu_model(char *out, size_t n)
-{
-    snprintf(out, n, "unknown");
-    FILE *fp = fopen("/proc/cpuinfo", "r");
-    if (!fp) return;
-    char line[512];
-    while (fgets(line, sizeof line, fp)) {
-        char *colon = strchr(line, ':');
-        if (strncmp(line, "model name", 10) == 0 && colon) {
-            snprintf(out, n, "%s", colon + 2);
-            out[strcspn(out, "\n")] = '\0';
-            break;
-        }
-    }
-    fclose(fp);
-}
 
 static void write_machine(JsonWriter *w, int threads)
 {
     struct utsname u;
     char cpu[256];
-    cpu_model(cpu, sizeof cpu);
+    machine_cpu_model(cpu, sizeof cpu);
     json_object_begin(w, "machine");
     if (uname(&u) == 0) {
         json_string(w, "host", u.nodename);
