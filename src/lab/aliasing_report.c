@@ -129,6 +129,7 @@ static void json_summary(JsonWriter *w, const char *key, const AliasingSummary *
     json_int(w, "measured", s->measured);
     json_int(w, "undersampled", s->undersampled);
     json_number(w, "undersampled_share", s->measured ? (double)s->undersampled / s->measured : 0.0);
+    json_int(w, "singular", s->singular);
     json_number(w, "m_max", s->m_max);
     json_number(w, "m_mean", s->m_mean);
     json_number(w, "m_s_max", s->m_s_max);
@@ -193,10 +194,10 @@ bool aliasing_report_write(const AliasingReport *r, const char *dir, const char 
 
 static void print_summary(FILE *fp, const char *what, const AliasingSummary *s)
 {
-    fprintf(fp, "%-9s %8ld measured, %5.1f%% undersampled (m > 1); m max %.4g mean %.4g; m_s max %.4g mean %.4g; "
-                "m_t max %.4g mean %.4g; storage factor %.4g\n",
-            what, s->measured, s->measured ? 100.0 * s->undersampled / s->measured : 0.0, s->m_max, s->m_mean,
-            s->m_s_max, s->m_s_mean, s->m_t_max, s->m_t_mean, s->storage);
+    fprintf(fp, "%-9s %8ld measured, %5.1f%% undersampled (m > 1), %ld edge-on to the light; m max %.4g mean %.4g; "
+                "m_s max %.4g mean %.4g; m_t max %.4g mean %.4g; storage factor %.4g\n",
+            what, s->measured, s->measured ? 100.0 * s->undersampled / s->measured : 0.0, s->singular, s->m_max,
+            s->m_mean, s->m_s_max, s->m_s_mean, s->m_t_max, s->m_t_mean, s->storage);
 }
 
 void aliasing_report_print(const AliasingReport *r, FILE *fp)

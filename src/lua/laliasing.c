@@ -5,9 +5,11 @@
  *                light = 1, axis = {1, 2, 5, ...}, frustum = 24, image = false}
  * returns { samples = SUMMARY, frustum = SUMMARY (when frustum > 0),
  *           axis = {{z, cascade, m_s, m_t, e_x, e_y}, ...} (per depth asked),
- *           map = {res, faces, projection, splits, width, height, pixel},
+ *           map = {res, faces, projection, splits, width, height, pixel, near, far,
+ *                  margin_texels (the border every fit adds on each side)},
  *           image = Image with channels m, m_s, m_t, proj, cascade (when asked) }
- * SUMMARY = {measured, undersampled, undersampled_share, m_max, m_mean, m_s_max,
+ * SUMMARY = {measured, undersampled, undersampled_share, singular (edge-on to the
+ *            light, left out of the statistics), m_max, m_mean, m_s_max,
  *            m_t_max, m_s_mean, m_t_mean, storage_factor, faces = {{measured,
  *            m_s_max, m_t_max}, ...}, hist = {{lo, hi, count}, ...}, depth =
  *            {{z_lo, z_hi, count, m_s_mean, m_t_mean, m_s_max, m_t_max,
@@ -42,6 +44,7 @@ static void push_summary(lua_State *L, const AliasingSummary *s)
     set_num(L, "measured", (double)s->measured);
     set_num(L, "undersampled", (double)s->undersampled);
     set_num(L, "undersampled_share", s->measured ? (double)s->undersampled / s->measured : 0.0);
+    set_num(L, "singular", (double)s->singular);
     set_num(L, "m_max", s->m_max);
     set_num(L, "m_mean", s->m_mean);
     set_num(L, "m_s_max", s->m_s_max);
@@ -107,7 +110,7 @@ static void push_axis(lua_State *L, const LightView *lv, const Scene *sc, const 
 static void push_map(lua_State *L, const ShadowMap *m, const Scene *sc)
 {
     AliasingView av = aliasing_view(&sc->camera);
-    lua_createtable(L, 0, 7);
+    lua_createtable(L, 0, 10);
     set_num(L, "res", m->res);
     set_num(L, "faces", m->num_faces);
     lua_pushstring(L, map_projection_name(m->view.projection));
@@ -121,6 +124,9 @@ static void push_map(lua_State *L, const ShadowMap *m, const Scene *sc)
     set_num(L, "width", sc->camera.width);
     set_num(L, "height", sc->camera.height);
     set_num(L, "pixel", av.pixel);
+    set_num(L, "near", sc->camera.near_dist);
+    set_num(L, "far", sc->camera.far_dist);
+    set_num(L, "margin_texels", LIGHTVIEW_MARGIN_TEXELS);
 }
 
 static void push_image(lua_State *L, const AliasingMap *a)

@@ -99,6 +99,11 @@ void aliasing_summary_add(AliasingSummary *s, const AliasingPoint *pt)
     double m = fmax(pt->m_s, pt->m_t);
     s->measured++;
     s->undersampled += m > 1.0;
+    if (m >= ALIASING_M_CAP) { /* a texel edge-on: projection aliasing without bound */
+        s->singular++;
+        s->hist[ALIASING_HIST_BINS - 1]++;
+        return;
+    }
     s->m_max = fmax(s->m_max, m);
     s->m_mean += m;
     s->m_s_max = fmax(s->m_s_max, pt->m_s);
@@ -126,7 +131,7 @@ void aliasing_summary_add(AliasingSummary *s, const AliasingPoint *pt)
 
 void aliasing_summary_finish(AliasingSummary *s, int res, int width, int height)
 {
-    double n = s->measured > 0 ? (double)s->measured : 1.0;
+    double n = s->measured > s->singular ? (double)(s->measured - s->singular) : 1.0;
     s->m_mean /= n;
     s->m_s_mean /= n;
     s->m_t_mean /= n;

@@ -55,6 +55,8 @@ void aliasing_normalised(const AliasingView *av, int res, const AliasingPoint *p
 
 typedef struct AliasingSummary {
     long measured, undersampled;          /* samples measured; of them with max(m_s, m_t) > 1 */
+    long singular;                        /* of them seen edge-on by the light (m = ALIASING_M_CAP): counted as
+                                             undersampled, left out of every statistic below */
     double m_max, m_mean;                 /* of max(m_s, m_t) */
     double m_s_max, m_t_max, m_s_mean, m_t_mean;
     /* Lloyd's storage factor: texels the maps would need for m <= 1 at

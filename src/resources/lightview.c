@@ -11,7 +11,6 @@
 #include "resources/warp.h"
 
 #define MAX_TAN_PERSPECTIVE 3.7320508 /* tan 75 degrees: a 150-degree frustum at most */
-#define MARGIN_TEXELS 2.0             /* fitted extents grow by this much on each side */
 #define NEAR_MIN_FRACTION 1e-4        /* near >= this fraction of far */
 
 const char *map_projection_name(MapProjection p)
@@ -208,7 +207,7 @@ static dvec3 face_up(const FaceOpts *o, dvec3 axis) { return o->aligned ? o->up 
 static void pad(double *lo, double *hi, int res, double min_width)
 {
     double w = fmax(*hi - *lo, min_width), c = 0.5 * (*hi + *lo);
-    w *= 1.0 + 2.0 * MARGIN_TEXELS / res;
+    w *= 1.0 + 2.0 * LIGHTVIEW_MARGIN_TEXELS / res;
     *lo = c - 0.5 * w;
     *hi = c + 0.5 * w;
 }
@@ -229,7 +228,7 @@ static void stabilize_extents(double ext[4], int res, double extent)
 {
     double need = fmax(ext[1] - ext[0], ext[3] - ext[2]);
     double k = ceil(4.0 * log2(fmax(need, 1e-300) / extent)), size = extent * exp2(k / 4.0);
-    while (size < need + 2.0 * (MARGIN_TEXELS + 1.0) * size / res) size *= exp2(0.25);
+    while (size < need + 2.0 * (LIGHTVIEW_MARGIN_TEXELS + 1.0) * size / res) size *= exp2(0.25);
     double texel = size / res;
     for (int a = 0; a < 2; a++) {
         double c = 0.5 * (ext[2 * a] + ext[2 * a + 1]);

@@ -16,6 +16,8 @@
 #include "rt/view.h"
 
 #define LIGHTVIEW_MAX_FACES 16
+/* Fitted maps cover their target with this border (texels) on every side. */
+#define LIGHTVIEW_MARGIN_TEXELS 2.0
 
 typedef enum MapProjection {
     MAP_PROJ_AUTO,        /* spot: perspective; directional: ortho; point, sphere: perspective if the

@@ -7,7 +7,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define MARGIN_TEXELS 2.0   /* as lightview.c's fits: the map covers its points with this border */
 #define N_UNIFORM 1e6       /* n beyond this many D is the uniform map (relative change < 1e-6) */
 #define TSM_XI 0.6          /* Martin & Tan 2004: the focus point maps to the 80% line */
 
@@ -147,6 +146,10 @@ static void frame_depths(const MapFace *f, const WarpSetup *w, Frame *fr)
     if (!lightview_base_ndc(f, p0, &x0, &y0, &z0n)) z0n = 0.5;
     double D = fr->y_max - fr->y_min;
     dvec3 p1 = base_unproject(f, qx + D * fr->a[0], qy + D * fr->a[1], z0n);
+    if (w->has_axis) { /* a frustum face: its own near and far edges (the light may look along the view) */
+        p0 = w->axis_from;
+        p1 = w->axis_to;
+    }
     fr->z0 = fmin(fmax(view_depth(w->view, p0), w->z_min), w->z_max);
     fr->z1 = fmin(fmax(view_depth(w->view, p1), w->z_min), w->z_max);
     if (!isfinite(fr->z0)) fr->z0 = w->z_min;
@@ -312,7 +315,7 @@ static bool fit_homography(double H[3][3], const double (*q)[2], int nq, int res
     double A[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 1}};
     for (int k = 0; k < 2; k++) {
         double c = 0.5 * (lo[k] + hi[k]), half = 0.5 * fmax(hi[k] - lo[k], 1e-12 * fmax(fabs(c), 1e-300));
-        half *= 1.0 + 2.0 * MARGIN_TEXELS / res;
+        half *= 1.0 + 2.0 * LIGHTVIEW_MARGIN_TEXELS / res;
         A[k][k] = 1.0 / half;
         A[k][2] = -c / half;
     }
@@ -394,7 +397,7 @@ static void fit_log(MapFace *f, const Frame *fr, double n, const double (*q)[2],
         lo = fmin(lo, l);
         hi = fmax(hi, l);
     }
-    double pad = 1.0 + 2.0 * MARGIN_TEXELS / res, half = 0.5 * fmax(hi - lo, 1e-12) * pad;
+    double pad = 1.0 + 2.0 * LIGHTVIEW_MARGIN_TEXELS / res, half = 0.5 * fmax(hi - lo, 1e-12) * pad;
     g->ku = 1.0 / half;
     g->cu = -0.5 * (lo + hi) / half;
     g->kv = 2.0 / pad; /* v in [0, 1] over the body -> [-1, 1] with the margin */

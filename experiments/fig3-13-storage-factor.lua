@@ -1,0 +1,95 @@
+-- fig3-13-storage-factor.lua -- course Fig. 3.13 (after Lloyd et al. 2006):
+-- the storage factor, which counts the error along both map axes, against
+-- the number of shadow maps, for z-partitioning (ZP, log splits, uniform
+-- maps), warping (W: one LiSPSM map), both (ZP+W: LiSPSM per slice) and
+-- frustum-face partitioning (FP, uniform per face, and FP+W, warped per face,
+-- at the number of light-facing faces), with an overhead light (ideal for
+-- warping) and with the light behind the viewer (no warping possible).
+-- Measured by lab:aliasing's frustum measure (resources/aliasing.h): Lloyd's
+-- maximum perspective aliasing error over the view frustum (each point's
+-- normal bisects eye and light directions), N^3 points; storage factor
+-- S = sum over maps of res^2 max(m_s) max(m_t) / screen pixels, the texels
+-- needed for error <= 1 everywhere, over the screen's pixels (independent
+-- of the map size). Scene: scenes/frustum-box.lua (B = the whole frustum,
+-- z_f / z_n = 100, 60 degrees, 320 x 240).
+--   build/shadowlab run experiments/fig3-13-storage-factor.lua [--out DIR] [--points N]
+-- Writes DIR (default reports/fig3-13): storage.csv, plots/overhead.*,
+-- plots/behind.*, summary.md.
+local sl = require "shadowlab"
+local plot = require "shadowlab.plot"
+
+local out, points = "reports/fig3-13", 24
+local i = 1
+while arg[i] do
+  if arg[i] == "--out" then out = arg[i + 1]; i = i + 2
+  elseif arg[i] == "--points" then points = math.tointeger(tonumber(arg[i + 1])); i = i + 2
+  else error("fig3-13: unknown argument " .. arg[i] .. " (--out DIR, --points N)", 0) end
+end
+
+local LIGHTS = { { name = "overhead", dir = { 0, -1, 0 }, label = "overhead light" },
+                 { name = "behind", dir = { 0, 0, -1 }, label = "light behind the viewer" } }
+local MAX_MAPS = 8
+
+local function storage(lab, params)
+  params.fit = "body"
+  local a = lab:aliasing{ params = params, frustum = points }
+  return a.frustum, a.map.faces
+end
+
+local csv = { "light,scheme,maps,storage_factor,m_s_max,m_t_max,measured" }
+local md = { "# Course Fig. 3.13: storage factor against the number of shadow maps", "",
+             "Lloyd et al. 2006's measure over the view frustum of scenes/frustum-box.lua (z_f / z_n = 100, " ..
+             "60 degrees, 320 x 240): storage factor = texels needed for a maximum error of 1 on both axes, over " ..
+             "the screen's pixels. ZP: log splits, uniform maps; W: one LiSPSM map (n_opt, Lloyd's falloff); " ..
+             "ZP+W: LiSPSM per slice; FP: one map per light-facing frustum face (uniform), FP+W: warped per face.", "" }
+for _, light in ipairs(LIGHTS) do
+  local lab <close> = sl.open("scenes/frustum-box.lua", { ["lights[1].direction"] = light.dir })
+  local series, table_rows = {}, {}
+  local function add(scheme, maps, fr)
+    csv[#csv + 1] = string.format("%s,%s,%d,%.6g,%.6g,%.6g,%d", light.name, scheme, maps, fr.storage_factor,
+                                  fr.m_s_max, fr.m_t_max, fr.measured)
+  end
+  for _, s in ipairs({ { "ZP", "ortho" }, { "ZP+W", "lispsm" } }) do
+    local pts, row = {}, { s[1] }
+    for m = 1, MAX_MAPS do
+      local fr = storage(lab, { projection = s[2], cascades = m, split_scheme = "log" })
+      pts[#pts + 1] = { m, fr.storage_factor }
+      row[#row + 1] = string.format("%.4g", fr.storage_factor)
+      add(s[1], m, fr)
+    end
+    series[#series + 1] = { title = s[1], points = pts, style = "linespoints" }
+    table_rows[#table_rows + 1] = row
+  end
+  local w = storage(lab, { projection = "lispsm" })
+  add("W", 1, w)
+  local wline = {}
+  for m = 1, MAX_MAPS do wline[#wline + 1] = { m, w.storage_factor } end
+  series[#series + 1] = { title = "W (one warped map)", points = wline, style = "lines" }
+  local fp_text = {}
+  for _, s in ipairs({ { "FP", "ortho" }, { "FP+W", "lispsm" } }) do
+    local fr, faces = storage(lab, { projection = s[2], split_scheme = "faces" })
+    add(s[1], faces, fr)
+    series[#series + 1] = { title = s[1], points = { { faces, fr.storage_factor } }, style = "points" }
+    fp_text[#fp_text + 1] = string.format("%s: %d maps, %.4g", s[1], faces, fr.storage_factor)
+  end
+  plot.draw(out .. "/plots", light.name, { title = "Course Fig. 3.13: storage factor, " .. light.label,
+    subtitle = "Lloyd's measure over the view frustum, z_f / z_n = 100", xlabel = "number of shadow maps",
+    ylabel = "storage factor", series = series, logy = true })
+  md[#md + 1] = "## " .. light.label
+  md[#md + 1] = ""
+  local head, rule = { "| scheme |" }, { "|---|" }
+  for m = 1, MAX_MAPS do head[#head + 1] = string.format(" %d |", m); rule[#rule + 1] = "---:|" end
+  md[#md + 1] = table.concat(head)
+  md[#md + 1] = table.concat(rule)
+  for _, row in ipairs(table_rows) do md[#md + 1] = "| " .. table.concat(row, " | ") .. " |" end
+  md[#md + 1] = ""
+  md[#md + 1] = string.format("W (one map): %.4g. %s.", w.storage_factor, table.concat(fp_text, "; "))
+  md[#md + 1] = ""
+  md[#md + 1] = string.format("![%s](plots/%s.svg)", light.label, light.name)
+  md[#md + 1] = ""
+end
+sl.mkdir(out)
+sl.write_file(out .. "/storage.csv", table.concat(csv, "\n") .. "\n")
+sl.write_file(out .. "/summary.md", table.concat(md, "\n") .. "\n")
+print(table.concat(md, "\n"))
+print("wrote " .. out .. "/{storage.csv,summary.md,plots/}")
