@@ -3,9 +3,10 @@
  * each child. A ray walks it nearest first: a ball bounds from below the tau
  * of everything inside it, so with min (the paper's combination) the walk
  * drops whatever cannot beat the best tau so far, and with product or sum
- * whatever has tau >= 1. The appendix's alternative, every bound grown by the
- * largest b ("R + b_max"), makes each ray near a 69k-triangle bunny under a
- * large light visit nearly every triangle: minutes per image instead of ms. */
+ * whatever has tau >= 1. The appendix's alternative, Embree user geometry
+ * with every bound grown by the largest b ("R + b_max"), makes each ray near
+ * a 69k-triangle bunny visit nearly every triangle: one 480x360 bunny image
+ * ran over 8 minutes (stopped) against 0.3-1.3 s with this walk. */
 #include "rt/outer.h"
 #include <embree3/rtcore_builder.h>
 #include <math.h>
