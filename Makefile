@@ -24,11 +24,22 @@ SAN_OBJ := $(LIB_SRC:%.c=$(B)/san/%.o)
 TEST_SRC:= $(sort $(wildcard tests/unit/*.c))
 TEST_OBJ:= $(TEST_SRC:%.c=$(B)/obj/%.o)
 TEST_SAN:= $(TEST_SRC:%.c=$(B)/san/%.o)
+# The stability suite's own test binary (tests/stability), under ASan + UBSan.
+STAB_SAN:= $(patsubst %.c,$(B)/san/%.o,$(sort $(wildcard tests/stability/*.c)))
+# Fuzzers (libFuzzer needs clang): the library below the front ends again,
+# instrumented for coverage with ASan + UBSan (gcc's build is the -Werror
+# gate; clang's own extra warnings do not stop it), and one harness per
+# parser in tests/fuzz/fuzz_*.c.
+FUZZ_CC := clang
+FUZZ_SAN:= -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+FUZZ_OBJ:= $(patsubst %.c,$(B)/fuzz/%.o,$(filter-out src/cli/% src/lua/%,$(LIB_SRC)))
+FUZZERS := $(patsubst tests/fuzz/%.c,$(B)/%,$(sort $(wildcard tests/fuzz/fuzz_*.c)))
+FUZZ_SECONDS ?= 600
 PLUGIN  := $(B)/libshadowlab_oiio.so
 # The Lua module for a plain lua5.4: require "shadowlab" with package.cpath = "build/?.so;...".
 LUAMOD  := $(B)/shadowlab.so
 
-.PHONY: all deps test test-unit demo bench docs clean FORCE
+.PHONY: all deps test test-unit demo bench docs clean fuzz fuzzers FORCE
 all: $(B)/shadowlab $(PLUGIN) $(LUAMOD)
 
 $(DEPS): scripts/deps.sh
@@ -52,6 +63,7 @@ $(B)/gen/version.h: FORCE
 	 printf '#define SHADOWLAB_COMMIT "%s"\n' "$$c" > $@.new; \
 	 cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
 $(B)/obj/src/lab/record.o $(B)/san/src/lab/record.o: $(B)/gen/version.h
+$(B)/fuzz/src/lab/record.o $(B)/fuzz/src/lua/lshadowlab.o: $(B)/gen/version.h
 $(B)/obj/src/lua/lshadowlab.o $(B)/san/src/lua/lshadowlab.o: $(B)/gen/version.h
 
 $(B)/libshadowlab.a: $(LIB_OBJ)
@@ -70,9 +82,22 @@ $(B)/test_unit: $(TEST_OBJ) $(B)/libshadowlab.a
 	$(CC) -o $@ $^ $(LIBS)
 $(B)/test_unit_san: $(TEST_SAN) $(SAN_OBJ)
 	$(CC) $(SAN) -o $@ $^ $(LIBS)
+$(B)/test_stability_san: $(STAB_SAN) $(SAN_OBJ)
+	$(CC) $(SAN) -o $@ $^ $(LIBS)
+
+$(B)/fuzz/%.o: %.c $(DEPS)
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(filter-out $(OPT),$(CFLAGS)) -O1 -Wno-error -Wno-unknown-warning-option $(FUZZ_SAN) \
+	    -fsanitize=fuzzer-no-link -MMD -MP -c $< -o $@
+$(B)/fuzz_%: $(B)/fuzz/tests/fuzz/fuzz_%.o $(FUZZ_OBJ)
+	$(FUZZ_CC) $(FUZZ_SAN) -fsanitize=fuzzer -o $@ $^ $(LIBS)
+fuzzers: $(FUZZERS)
+# The long fuzz run (README): every harness for FUZZ_SECONDS, new inputs kept in build/fuzz-corpus.
+fuzz: $(FUZZERS) $(PLUGIN)
+	./tests/fuzz/run.sh $(B) $(FUZZ_SECONDS) 1
 
 # Unit tests once under ASan+UBSan, then the CLI tests on the optimised build.
-test: all $(B)/test_unit_san
+test: all $(B)/test_unit_san $(B)/test_stability_san $(FUZZERS)
 	@B=$(B) ./tests/run.sh
 test-unit: all $(B)/test_unit
 	SHADOWLAB_MODEL_PATH=$${SHADOWLAB_MODEL_PATH:-../shared/models} SHADOWLAB_PLUGIN_DIR=$(CURDIR)/$(B) ./$(B)/test_unit $(T)
@@ -90,4 +115,4 @@ bench: all
 clean:
 	rm -rf $(B)
 
--include $(LIB_OBJ:.o=.d) $(SAN_OBJ:.o=.d) $(TEST_OBJ:.o=.d) $(TEST_SAN:.o=.d)
+-include $(LIB_OBJ:.o=.d) $(SAN_OBJ:.o=.d) $(TEST_OBJ:.o=.d) $(TEST_SAN:.o=.d) $(STAB_SAN:.o=.d) $(FUZZ_OBJ:.o=.d)

@@ -5,7 +5,7 @@
 set -u
 PACKAGES="build-essential pkg-config liblua5.4-dev lua5.4 libembree-dev libopenexr-dev \
 libopenimageio-dev zlib1g-dev gnuplot-nox glmark2-data \
-chromium parallel"
+chromium parallel clang libclang-rt-14-dev valgrind"
 
 missing=""
 for p in $PACKAGES; do

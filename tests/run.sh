@@ -1,7 +1,8 @@
 #!/bin/bash
-# run.sh -- the whole suite: unit tests (built with ASan + UBSan) and the
-# command-line tests (optimised build). Prints each suite's line and the
-# total as "N passed, N failed"; exits non-zero on any failure.
+# run.sh -- the whole suite: unit tests (built with ASan + UBSan), the
+# command-line tests (optimised build), the stability suite (ASan + UBSan),
+# the fuzzers, valgrind and the atomic-output kill test. Prints each suite's
+# line and the total as "N passed, N failed"; exits non-zero on any failure.
 set -u -o pipefail
 cd "$(dirname "$0")/.."
 B=${B:-build} # the build folder (Makefile: B)
@@ -17,10 +18,19 @@ trap 'rm -f "$log"' EXIT
 unit_status=$?
 SHADOWLAB_CACHE=$(mktemp -d) ./tests/cli/run.sh "$B/shadowlab" 2>&1 | tee -a "$log"
 ./tests/lua/run.sh "$B/shadowlab" 2>&1 | tee -a "$log"
+# The stability suite: its harness self-tests ("harness:") and the engine's
+# extreme cases under ASan + UBSan ("sanitized:"), the registry's whole
+# matrix in quick mode ("stability:"); then the short fuzz run, the valgrind
+# runs and the kill test of atomic outputs.
+"./$B/test_stability_san" 2>&1 | tee -a "$log"
+"./$B/shadowlab" stability --quick 2>&1 | tee -a "$log"
+./tests/fuzz/run.sh "$B" 2>&1 | tee -a "$log"
+./tests/valgrind/run.sh "$B/shadowlab" 2>&1 | tee -a "$log"
+./tests/stability/atomic.sh "$B/shadowlab" 2>&1 | tee -a "$log"
 passed=$(sed -n 's/^[a-z]*: \([0-9]*\) passed, \([0-9]*\) failed$/\1/p' "$log" | awk '{s+=$1} END {print s+0}')
 failed=$(sed -n 's/^[a-z]*: \([0-9]*\) passed, \([0-9]*\) failed$/\2/p' "$log" | awk '{s+=$1} END {print s+0}')
 suites=$(grep -c '^[a-z]*: [0-9]* passed, [0-9]* failed$' "$log")
-[ "$suites" -eq 3 ] || failed=$((failed + 1)) # a suite that died before its summary
+[ "$suites" -eq 9 ] || failed=$((failed + 1)) # a suite that died before its summary
 [ "$unit_status" -eq 0 ] || [ "$failed" -gt 0 ] || failed=1
 echo "total: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

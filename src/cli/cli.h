@@ -33,6 +33,7 @@ int cmd_list(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_reference(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
+int cmd_stability(int argc, char **argv); /* stability.c: the extreme-case suite */
 int cmd_run(int argc, char **argv);   /* script.c: a Lua script with the shadowlab module */
 int cmd_merge(int argc, char **argv); /* merge.c: shard records into one results folder */
 int cmd_aliasing(int argc, char **argv); /* aliasing.c: the sampling-error analysis of a map (course §3.1) */

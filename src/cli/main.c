@@ -8,6 +8,7 @@ static const struct { const char *name; int (*run)(int, char **); const char *su
     {"render", cmd_render, "render a technique's visibility for a scene"},
     {"reference", cmd_reference, "compute (or load from cache) the Embree ground truth"},
     {"compare", cmd_compare, "render, reference, metrics and every output"},
+    {"stability", cmd_stability, "every technique on every extreme case: finite, in [0,1], clear refusals"},
     {"run", cmd_run, "run a Lua script or experiment (sweeps, records, reports)"},
     {"merge", cmd_merge, "merge the records of a sweep's shards (--shard I/N)"},
     {"aliasing", cmd_aliasing, "shadow-map sampling error of a technique's map: error maps, histogram, storage factor"},

@@ -144,6 +144,7 @@ bool lab_render_timed(Lab *lab, const RenderRequest *req, const RenderTiming *ti
         return error_set(err, "--warmup %d outside [0, 1000]", timing->warmup);
     if (!(timing->budget_s >= 0 && timing->budget_s <= 1e6))
         return error_set(err, "time budget %g s outside [0, 1e6]", timing->budget_s);
+    if (!tech_params_check(req->tech, req->params, err)) return false;
     if (!tech_check_light(req->tech, &sc->lights[req->light_index], req->light_index + 1, err)) return false;
     double t0 = timer_now_s();
     const ViewSamples *vs = res_view_samples(lab->rm, sc, err);

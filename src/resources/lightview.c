@@ -425,11 +425,15 @@ static bool fit_face_along(LightView *lv, int index, const FitJob *j, const Targ
     bool directional = j->light->kind == LIGHT_DIRECTIONAL;
     MapProjection projection = proj != MAP_PROJ_AUTO ? proj : j->projection;
     bool warp = is_warp(projection);
-    FaceOpts o = {.aligned = !j->params->stabilize && (warp || is_body(j->fit) || j->params->cascades > 1),
-                  .up = j->view->fwd, .square = warp, .stabilize = j->params->stabilize};
+    /* stabilisation is for uniform maps of directional lights; elsewhere it has no effect */
+    bool stable = j->params->stabilize && directional && !warp;
+    FaceOpts o = {.aligned = !stable && (warp || is_body(j->fit) || j->params->cascades > 1),
+                  .up = j->view->fwd, .square = warp, .stabilize = stable};
     MapFace *f = &lv->face[index];
-    bool ok = directional ? fit_ortho(f, lv->res, j->light, j->fit, tg, &o, err)
-                          : fit_perspective(f, lv->res, j->light, j->fit, tg, &o, err);
+    bool parted = j->params->cascades > 1 || j->params->split == SPLIT_FACES;
+    MapFit fit = parted && j->fit != MAP_FIT_VIEW ? MAP_FIT_BODY : j->fit; /* a slice or face covers its target */
+    bool ok = directional ? fit_ortho(f, lv->res, j->light, fit, tg, &o, err)
+                          : fit_perspective(f, lv->res, j->light, fit, tg, &o, err);
     if (!ok || !warp) return ok;
     WarpSetup w = {.kind = projection, .params = j->params, .view = j->view, .directional = directional,
                    .light_axis = directional ? d3_normalize_or(d3_from(j->light->direction), d3(0, -1, 0))
@@ -501,8 +505,7 @@ static bool fit_face_partition(LightView *lv, const FitJob *j, Error *err)
 
 /* ---- refusals -------------------------------------------------------------------- */
 
-static bool check_request(const Light *light, MapProjection p, MapFit fit, int res, const LightViewParams *lp,
-                          Error *err)
+static bool check_request(const Light *light, MapProjection p, int res, const LightViewParams *lp, Error *err)
 {
     if (res < 1 || res > RASTER_MAX_SIZE) return error_set(err, "map_size %d outside [1, %d]", res, RASTER_MAX_SIZE);
     bool directional = light->kind == LIGHT_DIRECTIONAL;
@@ -516,13 +519,6 @@ static bool check_request(const Light *light, MapProjection p, MapFit fit, int r
     if (m > LIGHTVIEW_MAX_CASCADES) return error_set(err, "cascades %d outside [1, %d]", m, LIGHTVIEW_MAX_CASCADES);
     if ((m > 1 || lp->split == SPLIT_FACES) && (p == MAP_PROJ_CUBE || p == MAP_PROJ_PARABOLOID))
         return error_set(err, "cascades need a single-face projection per slice, not %s", map_projection_name(p));
-    if ((m > 1 || lp->split == SPLIT_FACES) && fit != MAP_FIT_VIEW && !is_body(fit))
-        return error_set(err, "cascades split the view: fit must be body, body_visible or view, not %s",
-                         map_fit_name(fit));
-    if (lp->stabilize && (!directional || (p != MAP_PROJ_AUTO && p != MAP_PROJ_ORTHO)))
-        return error_set(err, "stabilize keeps the texels of uniform (ortho) maps of directional lights still; "
-                              "projection %s of a %s light cannot be", map_projection_name(p),
-                         light_kind_name(light->kind));
     if (!(lp->blend >= 0.0 && lp->blend <= 0.5)) return error_set(err, "cascade_blend %g outside [0, 0.5]", lp->blend);
     return true;
 }
@@ -539,10 +535,13 @@ static double visible_far(const ViewSamples *vs, double near, double far)
     return d > near ? fmin(d * (1.0 + 1e-6), far) : far; /* nothing visible: the camera's far plane */
 }
 
+/* Each slice is fitted to its own intersection body B_i (its visible samples
+ * with fit=view): a partition follows the view whatever the fit asked for. */
 static bool fit_cascades(LightView *lv, const FitJob *j, const ViewSamples *vs, const uint8_t *cls, double z_n,
                          double z_f, Error *err)
 {
     const LightViewParams *lp = j->params;
+    MapFit fit = j->fit == MAP_FIT_VIEW ? MAP_FIT_VIEW : MAP_FIT_BODY;
     int m = lp->cascades > 1 ? lp->cascades : 1;
     lightview_splits(lp->split, lp->split_lambda, m, z_n, z_f, lp->pseudo_near, lv->split);
     lv->num_cascades = m;
@@ -553,7 +552,7 @@ static bool fit_cascades(LightView *lv, const FitJob *j, const ViewSamples *vs, 
     lv->blend = lp->blend;
     for (int i = 0; i < m; i++) {
         Target tg;
-        if (!target_init(j->scene, j->light, j->fit, vs, cls, j->view, lv->split[i], lv->split[i + 1], &tg, err))
+        if (!target_init(j->scene, j->light, fit, vs, cls, j->view, lv->split[i], lv->split[i + 1], &tg, err))
             return false;
         bool ok = fit_face(lv, i, j, &tg, err);
         free(tg.pts);
@@ -568,7 +567,7 @@ bool lightview_fit_with(const Scene *scene, const Light *light, MapProjection pr
 {
     memset(lv, 0, sizeof *lv);
     LightViewParams lp = params ? *params : lightview_params_default();
-    if (!check_request(light, projection, fit, res, &lp, err)) return false;
+    if (!check_request(light, projection, res, &lp, err)) return false;
     ViewFrustum vf = view_frustum(&scene->camera);
     double z_f = fit == MAP_FIT_BODY_VISIBLE ? visible_far(vs, vf.near, vf.far) : vf.far;
     vf.far = z_f;
@@ -579,6 +578,8 @@ bool lightview_fit_with(const Scene *scene, const Light *light, MapProjection pr
     Target tg;
     if (!target_init(scene, light, fit, vs, cls, &vf, vf.near, vf.far, &tg, err)) return false;
     lv->projection = projection == MAP_PROJ_AUTO ? resolve_auto(light, &tg) : projection;
+    if ((lp.cascades > 1 || lp.split == SPLIT_FACES) && lv->projection == MAP_PROJ_CUBE)
+        lv->projection = MAP_PROJ_PERSPECTIVE; /* AUTO: each slice or face gets a single perspective face */
     FitJob j = {scene, light, lv->projection, fit, &lp, &vf};
     bool ok = true, done = false;
     if (lp.split == SPLIT_FACES) { /* no light-facing face (a point light inside the frustum): one map */

@@ -4,6 +4,7 @@
  * each folder of $SHADOWLAB_MODEL_PATH (colon-separated), then Debian's
  * glmark2-data models folder. The first file found is used and recorded. */
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -97,6 +98,23 @@ bool scene_load_model(const SceneLoadCtx *ctx, const ModelChoice *choices, int n
     return error_set(err, "model not found: %s (searched %s; set SHADOWLAB_MODEL_PATH)", tried, where);
 }
 
+/* Emission weights visibility (reference.h): a NaN, infinite or negative
+ * texel would spread into every sample's value, so it is refused here. */
+static bool check_emission(const char *path, Image *img, Error *err)
+{
+    size_t n = image_count(img);
+    for (size_t i = 0; i < n; i++) {
+        float v = img->data[i];
+        if (isfinite(v) && v >= 0.0f) continue;
+        size_t px = i / (size_t)img->channels;
+        error_set(err, "%s: texel (%zu, %zu) channel %zu = %g: emission must be finite and >= 0", path,
+                  px % (size_t)img->width, px / (size_t)img->width, i % (size_t)img->channels, v);
+        image_free(img);
+        return false;
+    }
+    return true;
+}
+
 bool scene_load_light_image(const SceneLoadCtx *ctx, const char *name, Light *l, Error *err)
 {
     char path[SCENE_PATH_MAX];
@@ -106,5 +124,5 @@ bool scene_load_light_image(const SceneLoadCtx *ctx, const char *name, Light *l,
         return error_set(err, "image not found: %s (searched %s)", name, where);
     }
     snprintf(l->image_path, sizeof l->image_path, "%s", path);
-    return image_load_any(path, &l->emission, err);
+    return image_load_any(path, &l->emission, err) && check_emission(path, &l->emission, err);
 }

@@ -1,19 +1,22 @@
 /* sandbox.c -- the restricted Lua state behind scene files (see sandbox.h).
  * Limits: a counting allocator refuses growth past SANDBOX_MEMORY_LIMIT and a
- * count hook raises an error past SANDBOX_INSTRUCTION_LIMIT. */
+ * count hook raises an error past SANDBOX_INSTRUCTION_LIMIT instructions (C
+ * library loops charged as instructions) or SANDBOX_TIME_LIMIT_S seconds. */
 #include "scene/sandbox.h"
 #include <ctype.h>
 #include <lauxlib.h>
 #include <lualib.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/timer.h"
 
-#define HOOK_EVERY 10000
+#define HOOK_EVERY 1000
 
 struct Sandbox {
     lua_State *L;
     size_t mem_used;
     long instructions;
+    double start_s;
 };
 
 static void *sandbox_alloc(void *ud, void *ptr, size_t osize, size_t nsize)
@@ -31,15 +34,90 @@ static void *sandbox_alloc(void *ud, void *ptr, size_t osize, size_t nsize)
     return p;
 }
 
+static Sandbox *sandbox_of(lua_State *L)
+{
+    void *sb;
+    lua_getallocf(L, &sb);
+    return sb;
+}
+
+static void count_hook(lua_State *L, lua_Debug *ar);
+
+/* Add `work` to the budget; past a limit, raise, and arm the hook on every
+ * instruction so that the error escapes any pcall around it. */
+static void charge(lua_State *L, long work)
+{
+    Sandbox *sb = sandbox_of(L);
+    sb->instructions += work <= SANDBOX_INSTRUCTION_LIMIT ? work : SANDBOX_INSTRUCTION_LIMIT + 1;
+    bool over_count = sb->instructions > SANDBOX_INSTRUCTION_LIMIT;
+    if (!over_count && timer_now_s() - sb->start_s <= SANDBOX_TIME_LIMIT_S) return;
+    lua_sethook(L, count_hook, LUA_MASKCOUNT, 1);
+    if (over_count)
+        luaL_error(L, "instruction limit exceeded (%d million): does the scene loop forever?",
+                   (int)(SANDBOX_INSTRUCTION_LIMIT / 1000000));
+    luaL_error(L, "time limit exceeded (%.0f s): does the scene loop forever?", SANDBOX_TIME_LIMIT_S);
+}
+
 static void count_hook(lua_State *L, lua_Debug *ar)
 {
     (void)ar;
-    Sandbox *sb;
-    lua_getallocf(L, (void **)&sb);
-    sb->instructions += HOOK_EVERY;
-    if (sb->instructions > SANDBOX_INSTRUCTION_LIMIT)
-        luaL_error(L, "instruction limit exceeded (%d million): does the scene loop forever?",
-                   (int)(SANDBOX_INSTRUCTION_LIMIT / 1000000));
+    charge(L, HOOK_EVERY);
+}
+
+/* Call the wrapped library function (upvalue 1) with this call's arguments. */
+static int call_wrapped(lua_State *L)
+{
+    int n = lua_gettop(L);
+    lua_pushvalue(L, lua_upvalueindex(1));
+    lua_insert(L, 1);
+    lua_call(L, n, LUA_MULTRET);
+    return lua_gettop(L);
+}
+
+/* string.rep loops n times in C, even for an empty string. */
+static int rep_charged(lua_State *L)
+{
+    lua_Integer n = lua_tointeger(L, 2);
+    charge(L, n > 0 ? (long)(n <= SANDBOX_INSTRUCTION_LIMIT ? n : SANDBOX_INSTRUCTION_LIMIT + 1) : 0);
+    return call_wrapped(L);
+}
+
+/* table.insert(t, pos, v) and table.remove(t, pos) shift up to #t elements
+ * in C, and #t can be a border far beyond the table's real size. */
+static int shift_charged(lua_State *L)
+{
+    lua_Integer len = lua_gettop(L) >= 2 && lua_istable(L, 1) ? luaL_len(L, 1) : 0;
+    charge(L, len > 0 ? (long)(len <= SANDBOX_INSTRUCTION_LIMIT ? len : SANDBOX_INSTRUCTION_LIMIT + 1) : 0);
+    return call_wrapped(L);
+}
+
+/* Finalizers run during garbage collection with hooks off: refused. */
+static int setmetatable_checked(lua_State *L)
+{
+    if (lua_istable(L, 2)) {
+        lua_pushliteral(L, "__gc");
+        bool has_gc = lua_rawget(L, 2) != LUA_TNIL;
+        lua_pop(L, 1);
+        if (has_gc) return luaL_error(L, "setmetatable: __gc (finalizers) is not allowed in scene files");
+    }
+    return call_wrapped(L);
+}
+
+static void wrap(lua_State *L, const char *lib, const char *name, lua_CFunction fn)
+{
+    lua_getglobal(L, lib);
+    lua_getfield(L, -1, name);
+    lua_pushcclosure(L, fn, 1);
+    lua_setfield(L, -2, name);
+    lua_pop(L, 1);
+}
+
+static void remove_field(lua_State *L, const char *lib, const char *name)
+{
+    lua_getglobal(L, lib);
+    lua_pushnil(L);
+    lua_setfield(L, -2, name);
+    lua_pop(L, 1);
 }
 
 static void open_safe_libs(lua_State *L)
@@ -51,11 +129,17 @@ static void open_safe_libs(lua_State *L)
         luaL_requiref(L, libs[i].name, libs[i].func, 1);
         lua_pop(L, 1);
     }
-    static const char *const unsafe[] = {"dofile", "loadfile", "load", "require", "collectgarbage", "print"};
-    for (size_t i = 0; i < sizeof unsafe / sizeof unsafe[0]; i++) {
-        lua_pushnil(L);
-        lua_setglobal(L, unsafe[i]);
-    }
+    /* Code loading, output, and C loops the instruction count cannot bound. */
+    static const char *const unsafe[][2] = {
+        {LUA_GNAME, "dofile"},  {LUA_GNAME, "loadfile"},  {LUA_GNAME, "load"},     {LUA_GNAME, "require"},
+        {LUA_GNAME, "collectgarbage"}, {LUA_GNAME, "print"}, {LUA_GNAME, "warn"},
+        {LUA_STRLIBNAME, "dump"}, {LUA_STRLIBNAME, "find"}, {LUA_STRLIBNAME, "match"},
+        {LUA_STRLIBNAME, "gmatch"}, {LUA_STRLIBNAME, "gsub"}, {LUA_TABLIBNAME, "move"}};
+    for (size_t i = 0; i < sizeof unsafe / sizeof unsafe[0]; i++) remove_field(L, unsafe[i][0], unsafe[i][1]);
+    wrap(L, LUA_STRLIBNAME, "rep", rep_charged);
+    wrap(L, LUA_TABLIBNAME, "insert", shift_charged);
+    wrap(L, LUA_TABLIBNAME, "remove", shift_charged);
+    wrap(L, LUA_GNAME, "setmetatable", setmetatable_checked);
     /* Deterministic scenes: math.random is seeded with a fixed value. */
     if (luaL_dostring(L, "math.randomseed(20090101)") != LUA_OK) lua_pop(L, 1);
 }
@@ -66,6 +150,7 @@ Sandbox *sandbox_open(Error *err)
     if (!sb) { error_set(err, "out of memory"); return NULL; }
     sb->L = lua_newstate(sandbox_alloc, sb);
     if (!sb->L) { free(sb); error_set(err, "cannot create Lua state"); return NULL; }
+    sb->start_s = timer_now_s();
     open_safe_libs(sb->L);
     lua_sethook(sb->L, count_hook, LUA_MASKCOUNT, HOOK_EVERY);
     return sb;

@@ -1,15 +1,21 @@
 /* sandbox.h -- a Lua 5.4 state for untrusted scene files: only the base
  * (minus file and code loading), math, string, table and utf8 libraries; text
- * chunks only; a memory cap and an instruction budget, so a colleague's scene
- * file cannot run commands, hang or exhaust memory. */
+ * chunks only; a memory cap, an instruction budget and a time limit, so a
+ * colleague's scene file cannot run commands, hang or exhaust memory. Library
+ * functions whose C loops the instruction count cannot see are removed
+ * (string.dump, the pattern functions, table.move) or charged their work
+ * (string.rep, table.insert/remove); finalizers (__gc), which run with the
+ * instruction hook off, are refused; once a limit is hit every further
+ * instruction raises, so pcall cannot swallow it. */
 #ifndef SL_SANDBOX_H
 #define SL_SANDBOX_H
 #include <stddef.h>
 #include <lua.h>
 #include "core/error.h"
 
-#define SANDBOX_MEMORY_LIMIT ((size_t)512 << 20) /* bytes */
-#define SANDBOX_INSTRUCTION_LIMIT 100000000L     /* Lua VM instructions per sandbox (~2 s) */
+#define SANDBOX_MEMORY_LIMIT ((size_t)64 << 20)  /* bytes: one VM instruction on the largest strings stays ~10 ms */
+#define SANDBOX_INSTRUCTION_LIMIT 100000000L     /* Lua VM instructions per sandbox (~2 s), plus charged C work */
+#define SANDBOX_TIME_LIMIT_S 20.0                /* wall clock, for instructions that copy or compare long strings */
 
 typedef struct Sandbox Sandbox;
 

@@ -130,7 +130,8 @@ bool scene_load(const char *path, const char *const *overrides, int num_override
     memset(scene, 0, sizeof *scene);
     snprintf(scene->path, sizeof scene->path, "%s", path);
     default_name(path, scene->name, sizeof scene->name);
-    SceneLoadCtx ctx = {.path = path};
+    long long triangles = 0;
+    SceneLoadCtx ctx = {.path = path, .triangles = &triangles};
     dir_of(path, ctx.dir, sizeof ctx.dir);
     ctx.sandbox = sandbox_open(err);
     if (!ctx.sandbox) return false;

@@ -10,6 +10,7 @@ typedef struct SceneLoadCtx {
     const char *path;   /* the scene file */
     char dir[SCENE_PATH_MAX]; /* its folder */
     Sandbox *sandbox;
+    long long *triangles;     /* running total over the objects read so far */
 } SceneLoadCtx;
 
 bool scene_read_table(lua_State *L, int idx, const SceneLoadCtx *ctx, Scene *scene, Error *err);

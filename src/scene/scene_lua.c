@@ -12,6 +12,9 @@
 
 #define MAX_OBJECTS 100000
 #define MAX_LIGHTS 64
+/* Triangles per scene: procedural shapes could otherwise ask for gigabytes
+ * (100000 spheres of 4096 segments) before anything refuses them. */
+#define MAX_TRIANGLES (1 << 24)
 #define MAX_COORD 1e9
 #define MAX_LENGTH 1e7
 
@@ -338,6 +341,10 @@ static bool read_object(LuaReader *r, int idx, Object *o, int index, const Scene
         !rd_vec3(r, idx, "albedo", RANGE_CLOSED(0, 1), false, v3(0.8f, 0.8f, 0.8f), &o->albedo) ||
         !read_transform(r, idx, &M) || !build_shape(r, idx, shape, o, ctx))
         return false;
+    *ctx->triangles += o->mesh.num_triangles;
+    if (*ctx->triangles > MAX_TRIANGLES)
+        return rd_fail(r, NULL, "brings the scene to %lld triangles, over its budget of %d", *ctx->triangles,
+                       MAX_TRIANGLES);
     if (shape == SHAPE_SPHERE) record_sphere(o, &M);
     mesh_transform(&o->mesh, &M);
     return true;

@@ -146,6 +146,14 @@ bool tech_param_set(const Technique *t, const char *name, double v, double *valu
     return true;
 }
 
+bool tech_params_check(const Technique *t, const double *values, Error *err)
+{
+    double scratch[TECH_MAX_PARAMS];
+    for (int i = 0; i < t->num_params; i++)
+        if (!tech_param_set(t, t->params[i].name, values[i], scratch, err)) return false;
+    return true;
+}
+
 /* Text to number for a parameter's type: enum names, true/false, numbers. */
 static bool parse_value(const ParamDesc *p, const char *s, double *v)
 {

@@ -19,6 +19,10 @@ bool tech_param_parse(const Technique *t, const char *assignment, double *values
 /* Set one parameter by name from a number (ints, bools and enum indices too). */
 bool tech_param_set(const Technique *t, const char *name, double value, double *values, Error *err);
 int tech_param_index(const Technique *t, const char *name);
+/* Check a whole value array as tech_param_set would each value (finite,
+ * integral where the type says so, in range): library callers that fill
+ * values directly are refused by parameter name and range, before any work. */
+bool tech_params_check(const Technique *t, const double *values, Error *err);
 /* The value as text: enum names, true/false, integers, %.9g floats. */
 void tech_param_format(const ParamDesc *p, double value, char *out, size_t n);
 /* The valid range as text: "[1, 64]", "one of: a, b", "true or false". */

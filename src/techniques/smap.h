@@ -58,11 +58,11 @@ extern const char *const smap_select_names[];
      NULL},                                                                                                        \
     {"stabilize", PARAM_BOOL, 0, 0, 1, "",                                                                           \
      "uniform maps of directional lights: world-fixed orientation and texel-snapped extents on a ladder of "       \
-     "sizes, so texels stay still as the camera moves (course §3.2.1)",                                            \
+     "sizes, so texels stay still as the camera moves (course §3.2.1); no effect on other maps",                   \
      NULL},                                                                                                        \
     {"cascades", PARAM_INT, 1, 1, LIGHTVIEW_MAX_CASCADES, "maps",                                                    \
      "z-partitioning (cascaded / parallel-split shadow maps, course §3.2.3.1): this many maps of map_size^2, "      \
-     "each fitted to its slice of the view (fit body, body_visible or view); 1: a single map",                     \
+     "each fitted to its slice of the intersection body (its visible samples with fit=view); 1: a single map",     \
      NULL},                                                                                                        \
     {"split_scheme", PARAM_ENUM, 0, 0, 3, "",                                                                        \
      "split positions: practical (lambda log + (1 - lambda) uniform, Zhang 2006), log (C_i = z_n (z_f/z_n)^(i/m), " \

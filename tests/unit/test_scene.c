@@ -87,6 +87,31 @@ TEST(test_scene_sandbox_refuses_escape_hang_and_bloat)
     CHECK(!file_exists("/tmp/pwned"));
 }
 
+/* Escapes found by the stability suite (issue 7): libraries absent, C loops
+ * the instruction count cannot see charged or removed, finalizers refused,
+ * and a limit that pcall cannot swallow. Each must fail fast with a message. */
+TEST(test_scene_sandbox_refuses_hidden_loops_and_missing_libraries)
+{
+    expect_error("local x = package.loadlib('libc.so.6', 'system') return {}", NULL, "package", NULL);
+    expect_error("debug.sethook() return {}", NULL, "debug", NULL);
+    expect_error("local d = string.dump(function() end) return {}", NULL, "dump", NULL);
+    expect_error("local s = string.rep('a', 30000) string.find(s, '.-.-.-.-b') return {}", NULL, "find", NULL);
+    expect_error("local s = ('a'):rep(30000) s:match('.-.-.-.-b') return {}", NULL, "match", NULL);
+    expect_error("table.move({}, 1, 1e14, 2) return {}", NULL, "move", NULL);
+    expect_error("warn('@on') return {}", NULL, "warn", NULL);
+    expect_error("local s = string.rep('', 1e15) return {}", NULL, "instruction limit", NULL);
+    /* A border #t of 2^61 + 1 with 127 entries: insert and remove would shift that many in C. */
+    const char *border = "local t = {} for i = 1, 8 do t[i] = i end\n"
+                         "for k = 0, 58 do t[8 << k] = 1 t[(8 << k) + 1] = 1 end\n";
+    char text[400];
+    snprintf(text, sizeof text, "%s table.insert(t, 1, 0) return {}", border);
+    expect_error(text, NULL, "instruction limit", NULL);
+    snprintf(text, sizeof text, "%s table.remove(t, 1) return {}", border);
+    expect_error(text, NULL, "instruction limit", NULL);
+    expect_error("setmetatable({}, {__gc = function() while true do end end}) return {}", NULL, "__gc", NULL);
+    expect_error("while true do pcall(function() while true do end end) end", NULL, "instruction limit", NULL);
+}
+
 TEST(test_scene_heightfield_and_procedural_loops)
 {
     const char *text =

@@ -1,0 +1,64 @@
+/* stability.h -- the stability suite: every technique on every extreme case
+ * that applies to it (issue 7). Cases are data (stability_cases.c); the
+ * techniques come from the registry or from the caller, so a technique is
+ * covered the day it is registered. Each run happens in a forked child with a
+ * time bound, so a crash, hang or sanitizer report is one failed row, not the
+ * end of the suite. Asserted: output finite and in [0,1] on every lit
+ * candidate, the documented limit where one exists, and refusals of invalid
+ * input that name the parameter or key and its range. */
+#ifndef SL_STABILITY_H
+#define SL_STABILITY_H
+#include "techniques/registry.h"
+
+typedef enum StabStatus { STAB_PASS, STAB_FAIL, STAB_NOT_APPLICABLE } StabStatus;
+const char *stab_status_name(StabStatus s);
+
+typedef struct StabOptions {
+    bool quick;            /* reduced sizes and reference samples (make test); every case still runs */
+    double timeout_s;      /* per run; 0: 120 s */
+    int threads;           /* per run; 0: all cores */
+    const char *only;      /* run only cases whose name contains this; NULL: all */
+    const char *work_dir;  /* existing scratch folder for scene files and child logs */
+    const char *scene_dir; /* if set, every case's scene file is kept there (to reproduce a row) */
+} StabOptions;
+
+#define STAB_NAME_MAX 80
+#define STAB_DETAIL_MAX 640
+
+/* One row of the matrix: a technique (or "-" for engine input cases) on one
+ * case with one light kind. Error fields are NAN where no reference was made. */
+typedef struct StabResult {
+    char technique[STAB_NAME_MAX];
+    char case_name[STAB_NAME_MAX];
+    char light[24];              /* light kind used; "" when none */
+    StabStatus status;
+    char detail[STAB_DETAIL_MAX];/* why it failed or does not apply; notes on a pass */
+    long samples;                /* lit-candidate samples checked */
+    long nonfinite, out_of_range;
+    double mae, rmse, max_abs;   /* against the reference */
+    double noise_rms;            /* the reference's own noise */
+    int ref_samples;             /* light samples of that reference */
+    double seconds;              /* wall time of the run, child start to exit */
+} StabResult;
+
+typedef void (*StabRowFn)(const StabResult *row, void *user);
+
+/* Run the suite for `techs` (n entries; NULL: every registered technique),
+ * calling `row` after each run. Engine input cases run once, with technique
+ * "-", unless `engine_cases` is false. Children are forked, so the calling
+ * process must not have started threads yet (no Embree device, no OpenMP
+ * region): this is checked. Returns false (err set) only when the suite
+ * cannot run at all; failed rows are results, not errors. */
+bool stab_run(const Technique *const *techs, int n, bool engine_cases, const StabOptions *o, StabRowFn row,
+              void *user, Error *err);
+
+/* The static cases, for --help and docs. */
+int stab_case_count(void);
+const char *stab_case_name(int i);
+const char *stab_case_doc(int i);
+
+/* Write DIR/stability.{json,csv,md} atomically: the matrix with counts,
+ * errors and times, and the options it ran with. */
+bool stab_report_write(const char *dir, const StabResult *rows, int n, const StabOptions *o, Error *err);
+
+#endif

@@ -1,0 +1,687 @@
+/* stability_cases.c -- the extreme cases of issue 7 as data: each one a scene
+ * derived from a small base (a plane, a box and a ball under one light), the
+ * light kinds it runs with, and its documented limit or expected refusal.
+ * Scenes are Lua text so that every row can be reproduced with
+ * `shadowlab compare` on the file the suite keeps (stability -o DIR). */
+#include "lab/stability_cases.h"
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include "techniques/technique.h"
+
+#define DEG (M_PI / 180.0)
+
+static void set3(double *d, double x, double y, double z)
+{
+    d[0] = x;
+    d[1] = y;
+    d[2] = z;
+}
+
+void stab_objects_add(SceneSpec *s, const char *fmt, ...)
+{
+    size_t used = strlen(s->objects);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(s->objects + used, sizeof s->objects - used, fmt, ap);
+    va_end(ap);
+}
+
+StabFile *stab_file_add(SceneSpec *s, const char *name)
+{
+    StabFile *f = &s->files[s->num_files++];
+    memset(f, 0, sizeof *f);
+    snprintf(f->name, sizeof f->name, "%s", name);
+    return f;
+}
+
+static void file_printf(StabFile *f, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void file_printf(StabFile *f, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int k = vsnprintf(f->data + f->size, sizeof f->data - f->size, fmt, ap);
+    va_end(ap);
+    if (k > 0) f->size = f->size + (size_t)k < sizeof f->data ? f->size + (size_t)k : sizeof f->data - 1;
+}
+
+static void file_bytes(StabFile *f, const void *p, size_t n)
+{
+    if (f->size + n > sizeof f->data) return;
+    memcpy(f->data + f->size, p, n);
+    f->size += n;
+}
+
+/* ---- the base scene ------------------------------------------------------ */
+
+void stab_base_scene(SceneSpec *s, const StabSettings *st)
+{
+    memset(s, 0, sizeof *s);
+    set3(s->cam_pos, 0, 3, 4);
+    set3(s->cam_target, 0, 0.4, 0);
+    set3(s->cam_up, 0, 1, 0);
+    s->fov_deg = 45;
+    s->near_d = 0.05;
+    s->far_d = 50;
+    s->width = st->width;
+    s->height = st->height;
+    set3(s->light_pos, 0.7, 4, 0.5); /* in no plane of the box's faces */
+    set3(s->light_aim, 0, 0, 0);
+    s->light_size = 0.3;
+    stab_objects_add(s,
+                     "    { name = 'ground', shape = 'plane', size = {6, 6} },\n"
+                     "    { name = 'box', shape = 'box', size = {0.8, 0.8, 0.8}, translate = {0, 1, 0} },\n"
+                     "    { name = 'ball', shape = 'sphere', radius = 0.3, segments = 24, translate = {1.1, 0.5, 0.6} },\n");
+}
+
+static void base_objects(SceneSpec *s, const char *text)
+{
+    s->objects[0] = '\0';
+    stab_objects_add(s, "%s", text);
+}
+
+/* Text appended to a bounded buffer; numbers exactly (%.17g), NaN and
+ * infinities as the Lua expressions 0/0 and 1/0. */
+typedef struct Text { char *buf; size_t n, used; } Text;
+
+static void tx(Text *t, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void tx(Text *t, const char *fmt, ...)
+{
+    if (t->used >= t->n) return;
+    va_list ap;
+    va_start(ap, fmt);
+    int k = vsnprintf(t->buf + t->used, t->n - t->used, fmt, ap);
+    va_end(ap);
+    t->used = k < 0 ? t->n : t->used + (size_t)k;
+}
+
+static void tx_num(Text *t, double v)
+{
+    if (isnan(v)) tx(t, "(0/0)");
+    else if (isinf(v)) tx(t, v > 0 ? "(1/0)" : "(-1/0)");
+    else tx(t, "%.17g", v);
+}
+
+static void tx_vec(Text *t, const double *v)
+{
+    tx(t, "{");
+    for (int i = 0; i < 3; i++) {
+        tx_num(t, v[i]);
+        tx(t, i < 2 ? ", " : "}");
+    }
+}
+
+static void tx_key_num(Text *t, const char *key, double v)
+{
+    tx(t, ", %s = ", key);
+    tx_num(t, v);
+}
+
+static void tx_key_vec(Text *t, const char *key, const double *v)
+{
+    tx(t, ", %s = ", key);
+    tx_vec(t, v);
+}
+
+static void light_text(const SceneSpec *s, LightKind k, Text *t)
+{
+    double d[3] = {s->light_aim[0] - s->light_pos[0], s->light_aim[1] - s->light_pos[1],
+                   s->light_aim[2] - s->light_pos[2]};
+    tx(t, "{ type = '%s'", light_kind_name(k));
+    if (k != LIGHT_DIRECTIONAL) tx_key_vec(t, "position", s->light_pos);
+    if (k != LIGHT_POINT && k != LIGHT_SPHERE) tx_key_vec(t, "direction", d);
+    if (k == LIGHT_SPOT) tx(t, ", cone_angle = 60");
+    if (k == LIGHT_SPHERE || k == LIGHT_DISK) tx_key_num(t, "radius", s->light_size);
+    if (k == LIGHT_RECT || k == LIGHT_TEXTURED_RECT) {
+        tx_key_num(t, "width", 2 * s->light_size);
+        tx_key_num(t, "height", 2 * s->light_size);
+    }
+    if (k == LIGHT_TEXTURED_RECT) tx(t, ", image = 'stab-light.exr'");
+    tx(t, " }");
+}
+
+bool stab_scene_text(const SceneSpec *s, LightKind kind, char *out, size_t n)
+{
+    Text t = {out, n, 0};
+    tx(&t, "-- written by shadowlab stability; reproduce with: shadowlab compare THIS_FILE -t TECH\n"
+           "return {\n  camera = { position = ");
+    tx_vec(&t, s->cam_pos);
+    tx_key_vec(&t, "target", s->cam_target);
+    tx_key_vec(&t, "up", s->cam_up);
+    tx(&t, ",\n            ");
+    tx(&t, "fov = ");
+    tx_num(&t, s->fov_deg);
+    tx_key_num(&t, "near", s->near_d);
+    tx_key_num(&t, "far", s->far_d);
+    tx(&t, ", width = %d, height = %d },\n  lights = { ", s->width, s->height);
+    if (s->light_extra[0]) tx(&t, "%s", s->light_extra);
+    else light_text(s, kind, &t);
+    tx(&t, " },\n  objects = {\n%s  },\n}\n", s->objects);
+    return t.used < n;
+}
+
+/* ---- limits ---------------------------------------------------------------- */
+
+/* Light size 1e-6: the reference equals `hard` there (unit test
+ * test_reference_point_limit), so a soft technique must agree with the
+ * point-light shadow: MAE <= 0.02 and at most 2% of samples misclassified. */
+#define HARD_LIMIT_MAE 0.02
+#define HARD_LIMIT_MISCLASSIFIED 0.02
+
+static bool limit_hard(const Metrics *m, char *why, size_t n)
+{
+    const ErrorStats *e = &m->region[REGION_ALL];
+    if (e->mae <= HARD_LIMIT_MAE && e->misclassified <= HARD_LIMIT_MISCLASSIFIED) return true;
+    snprintf(why, n, "does not converge to the hard shadow at light size 1e-6: MAE %.4f (limit %.2f), %.2f%% misclassified (limit %.0f%%)",
+             e->mae, HARD_LIMIT_MAE, 100 * e->misclassified, 100 * HARD_LIMIT_MISCLASSIFIED);
+    return false;
+}
+
+/* Light below the receiver plane: the ground is unlit by shading (back-facing),
+ * never a shadow to estimate; only the objects' sides may face the light. */
+static bool limit_no_ground_candidates(const Metrics *m, char *why, size_t n)
+{
+    if (m->class_count[SAMPLE_BACKFACING] > 0) return true;
+    snprintf(why, n, "no back-facing samples: the ground under a light below it was not classified unlit");
+    return false;
+}
+
+/* No geometry in view: nothing is estimated and nothing may fail. */
+static bool limit_all_background(const Metrics *m, char *why, size_t n)
+{
+    long non_bg = 0;
+    for (int c = 1; c < SAMPLE_CLASS_COUNT; c++) non_bg += m->class_count[c];
+    if (non_bg == 0) return true;
+    snprintf(why, n, "%ld samples hit geometry in a view of the empty sky", non_bg);
+    return false;
+}
+
+/* ---- light cases ------------------------------------------------------------ */
+
+static void light_tiny(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    s->light_size = 1e-6;
+}
+
+static void light_huge(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    s->light_size = 100; /* the scene's extent is about 8.6: a sphere light this big contains it */
+}
+
+/* The box's top face is at y = 1.4: the light's centre on it (a sphere light
+ * rests on it), area lights half inside the box. */
+static void light_touching(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)st;
+    set3(s->light_pos, 0, k == LIGHT_SPHERE ? 1.4 + s->light_size : 1.4, 0);
+    set3(s->light_aim, 0.5, 0, 0.5);
+}
+
+static void light_inside_occluder(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    set3(s->light_pos, 0, 1, 0);
+    set3(s->light_aim, 0.3, 0, 0.2);
+    s->light_size = 0.1;
+}
+
+/* Beside the box, below its top: inside the scene's bounding box. */
+static void light_inside_bounds(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    set3(s->light_pos, 1.6, 0.6, -0.2);
+    set3(s->light_aim, -1, 0, 0);
+    s->light_size = 0.1;
+}
+
+static void light_below(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    set3(s->light_pos, 0.6, -2, 0.4);
+    set3(s->light_aim, 0, 0, 0);
+}
+
+/* 89.9 degrees from the ground's normal, 20 units from the centre. */
+static void light_grazing(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    double th = 89.9 * DEG;
+    set3(s->light_pos, 20 * sin(th), 20 * cos(th), 0);
+    set3(s->light_aim, 0, 0, 0);
+}
+
+/* Camera from (0, 3, 4) to the origin: the view direction is (0, -3, -4)
+ * exactly, in floats as in decimals. */
+static void view_axis_camera(SceneSpec *s)
+{
+    set3(s->cam_pos, 0, 3, 4);
+    set3(s->cam_target, 0, 0, 0);
+}
+
+static void light_along_view(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    view_axis_camera(s);
+    set3(s->light_pos, 0, 3, 4);
+    set3(s->light_aim, 0, 0, 0);
+}
+
+static void light_against_view(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    view_axis_camera(s);
+    set3(s->light_pos, 0, 0, 0);
+    set3(s->light_aim, 0, 3, 4);
+}
+
+/* Straight down: a light-space "look at" with up = +Y degenerates. */
+static void light_straight_down(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    set3(s->light_pos, 0, 4, 0);
+    set3(s->light_aim, 0, 0, 0);
+}
+
+/* ---- geometry cases --------------------------------------------------------- */
+
+static void geo_contact(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    base_objects(s, "    { name = 'ground', shape = 'plane', size = {6, 6} },\n"
+                    "    { name = 'box', shape = 'box', size = {0.8, 0.8, 0.8}, translate = {0, 0.4, 0} },\n"
+                    "    { name = 'ball', shape = 'sphere', radius = 0.3, segments = 24, translate = {1.1, 0.3, 0.6} },\n");
+}
+
+static void geo_coplanar(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    stab_objects_add(s, "    { name = 'decal', shape = 'disk', radius = 0.7, segments = 32, translate = {-0.8, 0, 0.5} },\n");
+}
+
+static void mesh_object(SceneSpec *s, const char *file, const char *extra)
+{
+    stab_objects_add(s, "    { name = 'mesh', shape = 'mesh', model = '%s'%s },\n", file, extra);
+}
+
+static void geo_zero_area(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    StabFile *f = stab_file_add(s, "zero-area.obj");
+    file_printf(f, "# a quad occluder, then triangles of zero area: collinear, one vertex thrice, two coincident\n"
+                   "v -0.5 1.5 -0.5\nv 0.5 1.5 -0.5\nv 0.5 1.5 0.5\nv -0.5 1.5 0.5\n"
+                   "v -1 1.8 0\nv 0 1.8 0\nv 1 1.8 0\n"
+                   "f 1 4 3\nf 1 3 2\nf 5 6 7\nf 5 7 6\nf 1 1 1\nf 2 2 3\nf 6 6 6\n");
+    mesh_object(s, "zero-area.obj", "");
+}
+
+/* A fan of triangles 2 long and 1e-6 wide, lying and standing. */
+static void geo_needles(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    StabFile *f = stab_file_add(s, "needles.obj");
+    for (int i = 0; i < 16; i++) {
+        double z = -0.8 + 0.1 * i;
+        bool standing = i % 2;
+        file_printf(f, "v -1 1.6 %.9g\nv 1 1.6 %.9g\nv 1 %.9g %.9g\nf %d %d %d\n", z, z, standing ? 1.600001 : 1.6,
+                    standing ? z : z + 1e-6, 3 * i + 1, 3 * i + 2, 3 * i + 3);
+    }
+    mesh_object(s, "needles.obj", "");
+}
+
+/* The six faces of a 0.8 box centred at (0, 1.5, 0), as quads of their own
+ * four vertices; `skip` is a bit set of faces left out. */
+static void box_faces(StabFile *f, unsigned skip, int copies, bool reversed_copy)
+{
+    static const int axis[6] = {0, 0, 1, 1, 2, 2};
+    int base = 0;
+    for (int c = 0; c < copies; c++) {
+        for (int face = 0; face < 6; face++) {
+            if (skip & (1u << face)) continue;
+            int a = axis[face], u = (a + 1) % 3, v = (a + 2) % 3;
+            double sign = face % 2 ? -0.4 : 0.4;
+            static const double corner[4][2] = {{-0.4, -0.4}, {0.4, -0.4}, {0.4, 0.4}, {-0.4, 0.4}};
+            for (int q = 0; q < 4; q++) {
+                double p[3];
+                p[a] = sign;
+                p[u] = corner[q][0];
+                p[v] = corner[q][1];
+                file_printf(f, "v %.9g %.9g %.9g\n", p[0], p[1] + 1.5, p[2]);
+            }
+            int i = base + 1;
+            file_printf(f, "f %d %d %d\nf %d %d %d\n", i, i + 1, i + 2, i, i + 2, i + 3);
+            if (reversed_copy) file_printf(f, "f %d %d %d\n", i, i + 2, i + 1);
+            base += 4;
+        }
+    }
+}
+
+static void geo_duplicated(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    StabFile *f = stab_file_add(s, "duplicated.obj");
+    file_printf(f, "# an unwelded box listed twice, with one reversed duplicate of every triangle\n");
+    box_faces(f, 0, 2, true);
+    mesh_object(s, "duplicated.obj", "");
+}
+
+static void geo_holes(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    StabFile *f = stab_file_add(s, "open-box.obj");
+    file_printf(f, "# a box without its +y (top) and +x faces\n");
+    box_faces(f, (1u << 0) | (1u << 2), 1, false);
+    mesh_object(s, "open-box.obj", "");
+}
+
+static void geo_single_triangle(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    StabFile *f = stab_file_add(s, "triangle.obj");
+    file_printf(f, "v -2 0 -2\nv 2 0 -2\nv 0 0 2\nf 1 3 2\n");
+    base_objects(s, "");
+    mesh_object(s, "triangle.obj", "");
+}
+
+/* 708 x 708 cells of two triangles: 1,002,528 triangles of bumps. */
+static void geo_million(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    base_objects(s, "    { name = 'bumps', shape = 'heightfield', size = {6, 6}, resolution = {708, 708},\n"
+                    "      elevation = function(x, z) return 0.15 * math.sin(3 * x) * math.cos(3 * z) end },\n"
+                    "    { name = 'box', shape = 'box', size = {0.8, 0.8, 0.8}, translate = {0, 1, 0} },\n");
+}
+
+/* Everything moved to x = z = 1e6 (a float ulp there is 0.0625), with a box
+ * of 1e-3 on the ground: detail far below the coordinates' resolution. */
+static void geo_far_coordinates(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    const double o = 1e6;
+    base_objects(s, "");
+    stab_objects_add(s,
+                     "    { name = 'ground', shape = 'plane', size = {6, 6}, translate = {%.17g, 0, %.17g} },\n"
+                     "    { name = 'box', shape = 'box', size = {0.8, 0.8, 0.8}, translate = {%.17g, 1, %.17g} },\n"
+                     "    { name = 'grain', shape = 'box', size = {0.001, 0.001, 0.001}, translate = {%.17g, 0.0005, %.17g} },\n",
+                     o, o, o, o, o + 0.5, o + 0.5);
+    set3(s->cam_pos, o, 3, o + 4);
+    set3(s->cam_target, o, 0.4, o);
+    set3(s->light_pos, o + 0.6, 4, o + 0.4);
+    set3(s->light_aim, o, 0, o);
+}
+
+static void geo_background(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    set3(s->cam_target, 0, 10, 10); /* 52 degrees up: nothing in view */
+}
+
+static void geo_camera_inside(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    set3(s->cam_pos, 0, 1, 0);
+    set3(s->cam_target, 0.3, 0.8, 1);
+    s->near_d = 0.01;
+}
+
+/* ---- camera cases ------------------------------------------------------------ */
+
+static void cam_near_tiny(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    s->near_d = 1e-6;
+}
+
+static void cam_far_near(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    s->near_d = 1e-3;
+    s->far_d = 1e3;
+}
+
+static void cam_fov_1(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    s->fov_deg = 1;
+}
+
+static void cam_fov_170(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    s->fov_deg = 170;
+}
+
+static void cam_1x1(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    s->width = s->height = 1;
+}
+
+static void cam_4096(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    s->width = s->height = 4096;
+}
+
+/* ---- input that must be refused before any computation ---------------------- */
+
+static void bad_obj(SceneSpec *s, const char *vertex, const char *extra)
+{
+    StabFile *f = stab_file_add(s, "bad.obj");
+    file_printf(f, "v 0 1 0\n%s\nv 0 1 1\nf 1 2 3\n", vertex);
+    mesh_object(s, "bad.obj", extra);
+}
+
+static void in_nan_vertex_obj(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    bad_obj(s, "v 1 nan 0", "");
+}
+
+static void in_inf_vertex_obj(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    bad_obj(s, "v 1 inf 0", "");
+}
+
+static void in_inf_vertex_ply(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    StabFile *f = stab_file_add(s, "bad.ply");
+    file_printf(f, "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                   "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n");
+    const float v[9] = {0, 1, 0, 1, INFINITY, 0, 0, 1, 1};
+    const unsigned char three = 3;
+    const int idx[3] = {0, 1, 2};
+    file_bytes(f, v, sizeof v); /* little-endian hosts only, like the test data it mirrors */
+    file_bytes(f, &three, 1);
+    file_bytes(f, idx, sizeof idx);
+    mesh_object(s, "bad.ply", "");
+}
+
+static void in_nan_translate(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    stab_objects_add(s, "    { shape = 'box', translate = {0/0, 1, 0} },\n");
+}
+
+static void in_nan_elevation(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    stab_objects_add(s, "    { shape = 'heightfield', size = {2, 2}, resolution = {4, 4},\n"
+                        "      elevation = function(x, z) if x > 0 then return 0/0 end return 0 end },\n");
+}
+
+static void in_overflow_transform(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    bad_obj(s, "v 1e38 1 0", ", scale = 1e7");
+}
+
+static void in_light(SceneSpec *s, const char *light)
+{
+    snprintf(s->light_extra, sizeof s->light_extra, "%s", light);
+}
+
+static void in_nan_light_position(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    in_light(s, "{ type = 'point', position = {0, 0/0, 0} }");
+}
+
+static void in_inf_light_position(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    in_light(s, "{ type = 'sphere', position = {0, 1/0, 0}, radius = 0.2 }");
+}
+
+static void in_nan_light_radius(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    in_light(s, "{ type = 'sphere', position = {0, 4, 0}, radius = 0/0 }");
+}
+
+static void in_nan_light_direction(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    in_light(s, "{ type = 'directional', direction = {0/0, -1, 0} }");
+}
+
+static void light_image(SceneSpec *s, float texel)
+{
+    StabFile *f = stab_file_add(s, "bad-light.exr");
+    f->exr = true;
+    f->exr_texel = texel;
+    in_light(s, "{ type = 'textured_rect', position = {0, 4, 0}, direction = {0, -1, 0}, width = 1, height = 1, "
+                "image = 'bad-light.exr' }");
+}
+
+static void in_nan_light_image(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    light_image(s, NAN);
+}
+
+static void in_inf_light_image(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    light_image(s, INFINITY);
+}
+
+static void in_negative_light_image(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    light_image(s, -0.5f);
+}
+
+static void in_nan_camera(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    s->fov_deg = NAN;
+}
+
+/* Procedural geometry past the scene's triangle budget: refused, never an
+ * allocation of many gigabytes. */
+static void in_triangle_budget(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    for (int i = 0; i < 5; i++) stab_objects_add(s, "    { shape = 'sphere', segments = 2048 },\n");
+}
+
+/* ---- the table ---------------------------------------------------------------- */
+
+#define AREA LIGHTS_AREA
+#define POSITIONED (LIGHTS_ALL & ~LIGHT_BIT(LIGHT_DIRECTIONAL))
+#define AIMED (LIGHT_BIT(LIGHT_SPOT) | LIGHT_BIT(LIGHT_DIRECTIONAL) | LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK) | \
+               LIGHT_BIT(LIGHT_TEXTURED_RECT))
+#define DIRECTIONAL LIGHT_BIT(LIGHT_DIRECTIONAL)
+
+static const StabCase cases[] = {
+    {"light_size_1e-6", GROUP_LIGHT, "area light of size 1e-6: converges to the hard shadow (MAE <= 0.02, <= 2% misclassified)",
+     AREA, PLAN_EACH, false, false, light_tiny, limit_hard, {0}},
+    {"light_larger_than_scene", GROUP_LIGHT, "area light of size 100 (a sphere light containing the whole scene)",
+     AREA, PLAN_EACH, false, false, light_huge, NULL, {0}},
+    {"light_touching_occluder", GROUP_LIGHT, "light centre on the box's top face (a sphere light resting on it)",
+     POSITIONED, PLAN_EACH, false, false, light_touching, NULL, {0}},
+    {"light_inside_occluder", GROUP_LIGHT, "light inside the closed box: the ground is in umbra",
+     POSITIONED, PLAN_EACH, false, true, light_inside_occluder, NULL, {0}},
+    {"light_inside_scene_bounds", GROUP_LIGHT, "light beside the box, inside the scene's bounding box",
+     LIGHT_BIT(LIGHT_POINT) | LIGHT_BIT(LIGHT_SPOT) | LIGHT_BIT(LIGHT_SPHERE), PLAN_EACH, false, true,
+     light_inside_bounds, NULL, {0}},
+    {"light_below_receiver", GROUP_LIGHT, "light under the ground plane: the ground is back-facing, not shadowed",
+     LIGHTS_ALL, PLAN_EACH, false, false, light_below, limit_no_ground_candidates, {0}},
+    {"light_grazing_89.9deg", GROUP_LIGHT, "light at 89.9 degrees from the ground's normal",
+     LIGHTS_ALL, PLAN_EACH, false, false, light_grazing, NULL, {0}},
+    {"light_straight_down", GROUP_LIGHT, "light aimed exactly along -Y (a light 'look at' with up = +Y degenerates)",
+     AIMED, PLAN_EACH, false, false, light_straight_down, NULL, {0}},
+    {"directional_along_view", GROUP_LIGHT, "directional light exactly parallel to the view direction",
+     DIRECTIONAL, PLAN_EACH, false, false, light_along_view, NULL, {0}},
+    {"directional_against_view", GROUP_LIGHT, "directional light exactly opposite to the view direction",
+     DIRECTIONAL, PLAN_EACH, false, false, light_against_view, NULL, {0}},
+
+    {"contact", GROUP_GEOMETRY, "box and ball resting on the ground (receiver touching the caster)",
+     LIGHTS_ALL, PLAN_TWO, false, false, geo_contact, NULL, {0}},
+    {"coplanar_caster", GROUP_GEOMETRY, "a disk lying in the ground's plane, casting and receiving",
+     LIGHTS_ALL, PLAN_TWO, false, false, geo_coplanar, NULL, {0}},
+    {"zero_area_triangles", GROUP_GEOMETRY, "collinear and coincident-vertex triangles in a mesh",
+     LIGHTS_ALL, PLAN_TWO, false, false, geo_zero_area, NULL, {0}},
+    {"needle_triangles", GROUP_GEOMETRY, "triangles 2 long and 1e-6 wide",
+     LIGHTS_ALL, PLAN_TWO, false, false, geo_needles, NULL, {0}},
+    {"duplicated_vertices", GROUP_GEOMETRY, "an unwelded box listed twice, with reversed duplicates of its triangles",
+     LIGHTS_ALL, PLAN_TWO, false, false, geo_duplicated, NULL, {0}},
+    {"mesh_with_holes", GROUP_GEOMETRY, "a box missing two faces",
+     LIGHTS_ALL, PLAN_TWO, false, false, geo_holes, NULL, {0}},
+    {"single_triangle", GROUP_GEOMETRY, "a scene of one triangle",
+     LIGHTS_ALL, PLAN_TWO, false, false, geo_single_triangle, NULL, {0}},
+    {"triangles_1e6", GROUP_GEOMETRY, "1,002,528 triangles of self-shadowing bumps",
+     LIGHTS_ALL, PLAN_ONE, true, false, geo_million, NULL, {0}},
+    {"coordinates_near_1e6", GROUP_GEOMETRY, "the scene at x = z = 1e6 with a box of 1e-3 (below the float ulp 0.0625)",
+     LIGHTS_ALL, PLAN_TWO, false, false, geo_far_coordinates, NULL, {0}},
+    {"every_pixel_background", GROUP_GEOMETRY, "camera looking at the empty sky",
+     LIGHTS_ALL, PLAN_TWO, false, false, geo_background, limit_all_background, {0}},
+    {"camera_inside_object", GROUP_GEOMETRY, "camera inside the closed box",
+     LIGHTS_ALL, PLAN_TWO, false, false, geo_camera_inside, NULL, {0}},
+
+    {"near_1e-6", GROUP_CAMERA, "near plane at 1e-6", LIGHTS_ALL, PLAN_TWO, false, false, cam_near_tiny, NULL, {0}},
+    {"far_over_near_1e6", GROUP_CAMERA, "near 1e-3, far 1e3", LIGHTS_ALL, PLAN_TWO, false, false, cam_far_near, NULL, {0}},
+    {"fov_1deg", GROUP_CAMERA, "vertical field of view 1 degree", LIGHTS_ALL, PLAN_TWO, false, false, cam_fov_1, NULL, {0}},
+    {"fov_170deg", GROUP_CAMERA, "vertical field of view 170 degrees", LIGHTS_ALL, PLAN_TWO, false, false, cam_fov_170, NULL, {0}},
+    {"image_1x1", GROUP_CAMERA, "a 1 x 1 image", LIGHTS_ALL, PLAN_TWO, false, false, cam_1x1, NULL, {0}},
+    {"image_4096x4096", GROUP_CAMERA, "a 4096 x 4096 image", LIGHTS_ALL, PLAN_ONE, true, false, cam_4096, NULL, {0}},
+
+    {"nan_vertex_obj", GROUP_INPUT, "OBJ vertex 'nan': refused with file and line", 0, PLAN_NONE, false, false,
+     in_nan_vertex_obj, NULL, {"bad.obj:2", "not finite"}},
+    {"inf_vertex_obj", GROUP_INPUT, "OBJ vertex 'inf': refused with file and line", 0, PLAN_NONE, false, false,
+     in_inf_vertex_obj, NULL, {"bad.obj:2", "not finite"}},
+    {"inf_vertex_ply", GROUP_INPUT, "binary PLY vertex +Inf: refused with file and record", 0, PLAN_NONE, false, false,
+     in_inf_vertex_ply, NULL, {"bad.ply", "not finite"}},
+    {"vertex_overflows_after_transform", GROUP_INPUT, "vertex 1e38 scaled by 1e7: refused after its transform", 0,
+     PLAN_NONE, false, false, in_overflow_transform, NULL, {"objects[4]", "not finite"}},
+    {"nan_translate", GROUP_INPUT, "translate = {0/0, 1, 0}: refused with the key path", 0, PLAN_NONE, false, false,
+     in_nan_translate, NULL, {"objects[4].translate[1]", "outside"}},
+    {"nan_heightfield", GROUP_INPUT, "elevation returning 0/0: refused with the key path", 0, PLAN_NONE, false, false,
+     in_nan_elevation, NULL, {"objects[4].elevation", "nan"}},
+    {"nan_light_position", GROUP_INPUT, "light position {0, 0/0, 0}: refused with the key path", 0, PLAN_NONE, false,
+     false, in_nan_light_position, NULL, {"lights[1].position[2]", "outside"}},
+    {"inf_light_position", GROUP_INPUT, "light position {0, 1/0, 0}: refused with the key path", 0, PLAN_NONE, false,
+     false, in_inf_light_position, NULL, {"lights[1].position[2]", "outside"}},
+    {"nan_light_radius", GROUP_INPUT, "light radius 0/0: refused with the key path and range", 0, PLAN_NONE, false,
+     false, in_nan_light_radius, NULL, {"lights[1].radius", "(0, 1e+07]"}},
+    {"nan_light_direction", GROUP_INPUT, "light direction {0/0, -1, 0}: refused with the key path", 0, PLAN_NONE,
+     false, false, in_nan_light_direction, NULL, {"lights[1].direction[1]", "outside"}},
+    {"nan_light_image", GROUP_INPUT, "light image with a NaN texel: refused naming the file and texel", 0, PLAN_NONE,
+     false, false, in_nan_light_image, NULL, {"bad-light.exr", "texel"}},
+    {"inf_light_image", GROUP_INPUT, "light image with an Inf texel: refused naming the file and texel", 0, PLAN_NONE,
+     false, false, in_inf_light_image, NULL, {"bad-light.exr", "texel"}},
+    {"negative_light_image", GROUP_INPUT, "light image with a negative texel: refused naming the file and texel", 0,
+     PLAN_NONE, false, false, in_negative_light_image, NULL, {"bad-light.exr", "texel"}},
+    {"nan_camera", GROUP_INPUT, "camera fov and position NaN: refused with the key path", 0, PLAN_NONE, false, false,
+     in_nan_camera, NULL, {"camera.fov", "(0, 180)"}},
+    {"scene_triangle_budget", GROUP_INPUT, "five 2048-segment spheres (21M triangles): refused at the scene's triangle budget", 0,
+     PLAN_NONE, false, false, in_triangle_budget, NULL, {"objects[7]", "triangle"}},
+};
+
+int stab_cases_count(void) { return (int)(sizeof cases / sizeof cases[0]); }
+const StabCase *stab_cases_at(int i) { return &cases[i]; }

@@ -1,0 +1,112 @@
+/* stability_cases.h -- internal interface between the stability runner
+ * (stability.c) and its case table (stability_cases.c). A case is a scene
+ * built as Lua text from a base (camera, one light of a kind the runner
+ * picks, objects, extra files such as meshes and light images), how its
+ * light kinds are chosen, and what is asserted beyond finite output in
+ * [0,1]: a documented limit, or the words a refusal must contain. */
+#ifndef SL_STABILITY_CASES_H
+#define SL_STABILITY_CASES_H
+#include <stddef.h>
+#include "metrics/metrics.h"
+#include "lab/stability.h"
+#include "scene/scene.h"
+
+#define STAB_MAX_FILES 4
+#define STAB_FILE_MAX 8192
+
+/* A file the scene needs next to it: bytes, or a 4x4 RGB EXR light image
+ * whose texel (1, 2) holds `exr_texel` (others a gradient in [0.2, 1]). */
+typedef struct StabFile {
+    char name[64];
+    bool exr;
+    float exr_texel;
+    char data[STAB_FILE_MAX];
+    size_t size;
+} StabFile;
+
+/* Everything a case's scene text is made from. Lengths in world units,
+ * angles in degrees, as in scene files. */
+typedef struct SceneSpec {
+    double cam_pos[3], cam_target[3], cam_up[3];
+    double fov_deg, near_d, far_d;
+    int width, height;
+    double light_pos[3], light_aim[3]; /* directional: direction = aim - pos */
+    double light_size;                 /* sphere, disk: radius; rect: half width and height */
+    char light_extra[256];             /* Lua text replacing the generated light, if set */
+    char objects[8192];                /* Lua text of the objects list's entries */
+    StabFile files[STAB_MAX_FILES];
+    int num_files;
+} SceneSpec;
+
+/* Sizes of a run: the view and the reference's light samples. */
+typedef struct StabSettings {
+    bool quick;
+    int width, height;
+    int ref_samples;
+} StabSettings;
+
+typedef enum CaseGroup { GROUP_LIGHT, GROUP_GEOMETRY, GROUP_CAMERA, GROUP_INPUT } CaseGroup;
+
+/* Which of the technique's light kinds a case runs with. */
+typedef enum LightPlan {
+    PLAN_EACH,      /* every kind of the case the technique handles */
+    PLAN_TWO,       /* the first delta kind and the first area kind it handles */
+    PLAN_ONE,       /* the first kind it handles (heavy cases) */
+    PLAN_NONE,      /* engine input cases: the scene must be refused */
+} LightPlan;
+
+typedef struct StabCase {
+    const char *name;
+    CaseGroup group;
+    const char *doc;               /* one line: what it checks and what is asserted */
+    unsigned lights;               /* LIGHT_BIT set the case is meaningful for */
+    LightPlan plan;
+    bool heavy;                    /* reduced reference samples */
+    bool may_refuse;               /* a technique may refuse it with a clear message */
+    void (*build)(SceneSpec *s, LightKind kind, const StabSettings *st);
+    /* Documented limit on the metrics against the reference; NULL: none.
+     * Returns false with the reason in `why`. */
+    bool (*limit)(const Metrics *m, char *why, size_t n);
+    const char *refusal[3];        /* PLAN_NONE: words the refusal must contain */
+} StabCase;
+
+/* Probes generated from each ParamDesc of a technique. */
+typedef enum ParamProbe {
+    PROBE_NONE,
+    PROBE_AT_MIN, PROBE_MIN_PLUS_ONE, PROBE_AT_MAX, /* render at the value */
+    PROBE_BELOW_MIN, PROBE_ABOVE_MAX,                /* refused naming the parameter and its range */
+    PROBE_NONFINITE,                                 /* NaN and +-Inf refused, also raw in lab_render */
+    PROBE_COUNT
+} ParamProbe;
+
+/* One run: a technique (NULL for engine input cases) on a case, or on a
+ * parameter probe (c == NULL) over the base scene, with one light kind. */
+typedef struct StabJob {
+    const Technique *tech;
+    const StabCase *c;
+    int param;
+    ParamProbe probe;
+    LightKind kind;
+    StabSettings st;
+    int threads;
+} StabJob;
+
+/* The value a render probe sets, or the refused value of BELOW/ABOVE. */
+double stab_probe_value(const ParamDesc *p, ParamProbe probe);
+const char *stab_probe_suffix(ParamProbe probe);
+/* Runs in the forked child: the job on the scene file, results into r. */
+void stab_job_execute(const StabJob *j, const char *scene_path, StabResult *r);
+
+int stab_cases_count(void);
+const StabCase *stab_cases_at(int i);
+
+/* The base scene every case starts from (also used by parameter probes). */
+void stab_base_scene(SceneSpec *s, const StabSettings *st);
+/* The scene's Lua text with a light of `kind` (ignored when light_extra is set). */
+bool stab_scene_text(const SceneSpec *s, LightKind kind, char *out, size_t n);
+/* Append Lua text to s->objects. */
+void stab_objects_add(SceneSpec *s, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* A file next to the scene; returns it for filling. */
+StabFile *stab_file_add(SceneSpec *s, const char *name);
+
+#endif

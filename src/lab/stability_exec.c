@@ -1,0 +1,248 @@
+/* stability_exec.c -- what one stability run does, inside its forked child:
+ * load the case's scene, render the technique (with a parameter probe's
+ * value), count non-finite and out-of-range outputs over the lit candidates,
+ * measure the error against a cheap reference, and check the case's limit;
+ * or check that bad input is refused with a message naming what is wrong. */
+#include <math.h>
+#include <stdarg.h>
+#include <omp.h>
+#include <stdio.h>
+#include <string.h>
+#include "lab/stability_cases.h"
+#include "lab/lab.h"
+
+static bool fail(StabResult *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static bool fail(StabResult *r, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(r->detail, sizeof r->detail, fmt, ap);
+    va_end(ap);
+    r->status = STAB_FAIL;
+    return false;
+}
+
+static void note(StabResult *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void note(StabResult *r, const char *fmt, ...)
+{
+    size_t used = strlen(r->detail);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(r->detail + used, sizeof r->detail - used, fmt, ap);
+    va_end(ap);
+}
+
+/* ---- parameter values --------------------------------------------------- */
+
+const char *stab_probe_suffix(ParamProbe probe)
+{
+    static const char *const names[PROBE_COUNT] = {"", "min", "min_plus_1", "max", "below_min", "above_max",
+                                                   "nonfinite"};
+    return names[probe];
+}
+
+double stab_probe_value(const ParamDesc *p, ParamProbe probe)
+{
+    bool integral = p->type != PARAM_FLOAT;
+    double below = integral ? 1.0 : fmax(fabs(p->min) * 1e-6, 1e-9);
+    double above = integral ? 1.0 : fmax(fabs(p->max) * 1e-6, 1e-9);
+    switch (probe) {
+    case PROBE_AT_MIN: return p->min;
+    case PROBE_MIN_PLUS_ONE: return p->min + 1.0;
+    case PROBE_AT_MAX: return p->max;
+    case PROBE_BELOW_MIN: return p->min - below;
+    case PROBE_ABOVE_MAX: return p->max + above;
+    default: return NAN;
+    }
+}
+
+/* A refusal must name the parameter and its valid range. */
+static bool refusal_names_range(const Technique *t, const ParamDesc *p, const char *what, bool accepted,
+                                const Error *e, StabResult *r)
+{
+    char range[256];
+    tech_param_range(p, range, sizeof range);
+    if (accepted) return fail(r, "%s: %s was accepted", t->name, what);
+    if (!strstr(e->msg, p->name) || !strstr(e->msg, range))
+        return fail(r, "refusal of %s does not name '%s' and %s: %s", what, p->name, range, e->msg);
+    return true;
+}
+
+static bool check_refused_value(const Technique *t, int i, double v, StabResult *r)
+{
+    double vals[TECH_MAX_PARAMS];
+    tech_params_default(t, vals);
+    Error e = {{0}};
+    char what[96];
+    snprintf(what, sizeof what, "%s = %.9g", t->params[i].name, v);
+    return refusal_names_range(t, &t->params[i], what, tech_param_set(t, t->params[i].name, v, vals, &e), &e, r);
+}
+
+static bool check_refused_text(const Technique *t, int i, const char *text, StabResult *r)
+{
+    double vals[TECH_MAX_PARAMS];
+    tech_params_default(t, vals);
+    char assign[160];
+    snprintf(assign, sizeof assign, "%s=%s", t->params[i].name, text);
+    Error e = {{0}};
+    return refusal_names_range(t, &t->params[i], assign, tech_param_parse(t, assign, vals, &e), &e, r);
+}
+
+/* A raw non-finite value handed to lab_render (as the Lua layer or any
+ * library caller could) is refused before the technique's prepare runs. */
+static bool check_render_refuses_nan(Lab *lab, const Technique *t, int i, StabResult *r)
+{
+    double vals[TECH_MAX_PARAMS];
+    tech_params_default(t, vals);
+    vals[i] = NAN;
+    RenderRequest req = {t, vals, 0, 1};
+    RenderResult out;
+    Error e = {{0}};
+    bool ok = lab_render(lab, &req, &out, &e);
+    if (ok) render_result_free(&out);
+    if (ok) return fail(r, "lab_render accepted %s = NaN", t->params[i].name);
+    if (!strstr(e.msg, t->params[i].name)) return fail(r, "lab_render's refusal of NaN does not name %s: %s", t->params[i].name, e.msg);
+    return true;
+}
+
+static void run_param_refusal(const StabJob *j, Lab *lab, StabResult *r)
+{
+    const Technique *t = j->tech;
+    int i = j->param;
+    bool ok;
+    if (j->probe == PROBE_NONFINITE) {
+        ok = check_refused_value(t, i, NAN, r) && check_refused_value(t, i, INFINITY, r) &&
+             check_refused_value(t, i, -INFINITY, r) && check_refused_text(t, i, "nan", r) &&
+             check_refused_text(t, i, "inf", r) && check_render_refuses_nan(lab, t, i, r);
+    } else {
+        ok = check_refused_value(t, i, stab_probe_value(&t->params[i], j->probe), r);
+    }
+    if (ok) r->status = STAB_PASS;
+}
+
+/* ---- rendering -------------------------------------------------------------- */
+
+static bool probe_params(const StabJob *j, double *vals, StabResult *r)
+{
+    tech_params_default(j->tech, vals);
+    if (j->probe == PROBE_NONE) return true;
+    const ParamDesc *p = &j->tech->params[j->param];
+    double v = stab_probe_value(p, j->probe);
+    Error e;
+    if (!tech_param_set(j->tech, p->name, v, vals, &e)) return fail(r, "value at the bound was refused: %s", e.msg);
+    note(r, "%s = %.9g. ", p->name, v);
+    return true;
+}
+
+/* Non-finite and out-of-range outputs over the lit candidates. */
+static void count_outputs(const Image *v, const uint8_t *cls, StabResult *r)
+{
+    long count = (long)v->width * v->height;
+    for (long s = 0; s < count; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        r->samples++;
+        for (int c = 0; c < v->channels; c++) {
+            float x = v->data[s * v->channels + c];
+            if (!isfinite(x)) r->nonfinite++;
+            else if (x < 0.0f || x > 1.0f) r->out_of_range++;
+        }
+    }
+}
+
+static int reference_samples(const StabJob *j) { return j->c && j->c->heavy ? 16 : j->st.ref_samples; }
+
+/* Error against a cheap reference; the case's limit if it has one. */
+static bool measure(const StabJob *j, Lab *lab, const Image *v, const uint8_t *cls, StabResult *r)
+{
+    RefRequest rq = {0, {MEASURE_VISIBILITY, reference_samples(j), SAMPLING_R2, 1}, NULL};
+    RefInfo info;
+    Error e;
+    const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &e);
+    if (!ref) return fail(r, "reference failed: %s", e.msg);
+    Metrics m;
+    if (!metrics_compute(v, ref, cls, &m, NULL, &e)) return fail(r, "metrics failed: %s", e.msg);
+    r->ref_samples = light_is_delta(&lab_scene(lab)->lights[0]) ? 1 : rq.params.samples;
+    r->noise_rms = m.noise_rms;
+    if (m.region[REGION_ALL].count > 0) {
+        r->mae = m.region[REGION_ALL].mae;
+        r->rmse = m.region[REGION_ALL].rmse;
+        r->max_abs = m.region[REGION_ALL].max_abs;
+    }
+    char why[400] = "";
+    if (j->c && j->c->limit && !j->c->limit(&m, why, sizeof why)) return fail(r, "%s", why);
+    return true;
+}
+
+static void run_render(const StabJob *j, Lab *lab, StabResult *r)
+{
+    double vals[TECH_MAX_PARAMS];
+    if (!probe_params(j, vals, r)) return;
+    RenderRequest req = {j->tech, vals, 0, 1};
+    RenderResult out;
+    Error e = {{0}};
+    bool may_refuse = (j->c && j->c->may_refuse) || j->probe == PROBE_AT_MAX;
+    if (!lab_render(lab, &req, &out, &e)) {
+        if (may_refuse && e.msg[0]) {
+            r->status = STAB_PASS;
+            note(r, "refused (allowed here): %s", e.msg);
+        } else {
+            fail(r, "render failed: %s", e.msg);
+        }
+        return;
+    }
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &e);
+    if (!cls) {
+        render_result_free(&out);
+        fail(r, "classes: %s", e.msg);
+        return;
+    }
+    count_outputs(&out.visibility, cls, r);
+    /* Quick runs of heavy cases check the output, not its error (no reference). */
+    bool ok = (j->st.quick && j->c && j->c->heavy) || measure(j, lab, &out.visibility, cls, r);
+    render_result_free(&out);
+    if (!ok) return;
+    if (r->nonfinite || r->out_of_range)
+        fail(r, "%ld non-finite and %ld out-of-range values in [0, 1] over %ld lit samples", r->nonfinite,
+             r->out_of_range, r->samples);
+    else r->status = STAB_PASS;
+    if (r->status == STAB_PASS && r->samples == 0) note(r, "no lit candidates. ");
+}
+
+/* ---- bad scenes ---------------------------------------------------------------- */
+
+static void run_scene_refusal(const StabJob *j, const char *path, StabResult *r)
+{
+    Error e = {{0}};
+    Lab *lab = lab_open(path, NULL, 0, &e);
+    if (lab) {
+        lab_close(lab);
+        fail(r, "the scene was accepted");
+        return;
+    }
+    for (int w = 0; w < 3 && j->c->refusal[w]; w++)
+        if (!strstr(e.msg, j->c->refusal[w])) {
+            fail(r, "refusal lacks '%s': %s", j->c->refusal[w], e.msg);
+            return;
+        }
+    r->status = STAB_PASS;
+    snprintf(r->detail, sizeof r->detail, "refused: %s", e.msg);
+}
+
+void stab_job_execute(const StabJob *j, const char *scene_path, StabResult *r)
+{
+    if (j->threads > 0) omp_set_num_threads(j->threads);
+    rt_set_threads(j->threads > 0 ? j->threads : omp_get_max_threads());
+    if (j->c && j->c->plan == PLAN_NONE) {
+        run_scene_refusal(j, scene_path, r);
+        return;
+    }
+    Error e;
+    Lab *lab = lab_open(scene_path, NULL, 0, &e);
+    if (!lab) {
+        fail(r, "the case's scene was refused: %s", e.msg);
+        return;
+    }
+    if (j->probe >= PROBE_BELOW_MIN) run_param_refusal(j, lab, r);
+    else run_render(j, lab, r);
+    lab_close(lab);
+}

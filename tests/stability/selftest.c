@@ -1,0 +1,164 @@
+/* selftest.c -- the stability suite's own test binary (make test builds it
+ * with ASan + UBSan). First it proves the harness catches what it claims to:
+ * techniques that are not in the registry and misbehave on purpose (NaN,
+ * out of range, crash, hang, heap overflow, leak, wrong limit, refusals)
+ * must each give the failed row, and light kinds a technique does not handle
+ * must give "not applicable". Then it runs the matrix in quick
+ * mode for `hard` and the engine's input cases, under the sanitizers.
+ * Prints "harness: N passed, N failed", then "sanitized: N passed, N failed". */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "cli/cli.h"
+#include "lab/stability.h"
+
+/* ---- techniques that misbehave on purpose ------------------------------------ */
+
+typedef enum Misbehaviour { OK_HALF, GIVES_NAN, GIVES_1_5, CRASHES, HANGS, OVERFLOWS, LEAKS, REFUSES, ALWAYS_LIT } Misbehaviour;
+
+static Misbehaviour current;
+
+static bool fake_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    (void)ctx;
+    *state = NULL;
+    if (current == REFUSES) return error_set(err, "this technique refuses every scene");
+    if (current == HANGS)
+        for (volatile int spin = 1; spin;) {
+        }
+    if (current == LEAKS) {
+        void *volatile lost = malloc(4096); /* never freed: LeakSanitizer's report at exit */
+        (void)lost;
+    }
+    return true;
+}
+
+static void fake_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
+{
+    (void)state;
+    static const float values[] = {[OK_HALF] = 0.5f, [GIVES_1_5] = 1.5f, [ALWAYS_LIT] = 1.0f};
+    for (int s = begin; s < end; s++) {
+        float v = current == GIVES_NAN ? NAN : values[current];
+        if (current == CRASHES) raise(SIGSEGV);
+        if (current == OVERFLOWS) {
+            volatile char *p = malloc(8);
+            p[8] = 1; /* one past the end: AddressSanitizer's report */
+            free((void *)p);
+        }
+        for (int c = 0; c < ctx->channels; c++) out[(size_t)(s - begin) * (size_t)ctx->channels + (size_t)c] = v;
+    }
+}
+
+static const ParamDesc fake_params[] = {
+    {"weight", PARAM_FLOAT, 0.5, 0.0, 1.0, "", "a float parameter", NULL},
+    {"taps", PARAM_INT, 4, 1, 64, "texels", "an int parameter", NULL},
+};
+static const char *const no_resources[] = {NULL};
+
+static Technique fake(const char *name, unsigned lights)
+{
+    return (Technique){.name = name, .family = "test", .source = "selftest", .summary = "misbehaves on purpose",
+                       .params = fake_params, .num_params = 2, .resources = no_resources, .rgb = true,
+                       .lights = lights, .prepare = fake_prepare, .evaluate = fake_evaluate, .release = NULL};
+}
+
+/* ---- running one case ---------------------------------------------------------- */
+
+static int passed, failed;
+
+typedef struct Collected { StabResult rows[64]; int n; } Collected;
+
+static void collect(const StabResult *r, void *user)
+{
+    Collected *c = user;
+    if (c->n < 64) c->rows[c->n++] = *r;
+}
+
+static Collected run(Misbehaviour m, unsigned lights, const char *only, double timeout_s)
+{
+    current = m;
+    Technique t = fake("fake", lights);
+    const Technique *list[1] = {&t};
+    char work[] = "/tmp/shadowlab-selftest-XXXXXX";
+    Collected c = {.n = 0};
+    if (!mkdtemp(work)) return c;
+    StabOptions o = {true, timeout_s, 1, only, work, NULL};
+    Error err;
+    if (!stab_run(list, 1, false, &o, collect, &c, &err)) printf("    stab_run: %s\n", err.msg);
+    rmdir(work);
+    return c;
+}
+
+/* Every row of the run has `status` and its detail contains `word`. */
+static void expect(const char *name, Misbehaviour m, unsigned lights, const char *only, StabStatus status,
+                   const char *word)
+{
+    Collected c = run(m, lights, only, 5.0);
+    bool ok = c.n > 0;
+    for (int i = 0; ok && i < c.n; i++)
+        ok = c.rows[i].status == status && (!word || strstr(c.rows[i].detail, word));
+    printf("%s %s", ok ? "ok  " : "FAIL", name);
+    if (!ok) {
+        printf(": expected %s with '%s'; got %d rows", stab_status_name(status), word ? word : "", c.n);
+        for (int i = 0; i < c.n; i++) printf("\n    %s %s[%s]: %s", stab_status_name(c.rows[i].status), c.rows[i].case_name, c.rows[i].light, c.rows[i].detail);
+    }
+    printf("\n");
+    fflush(stdout);
+    ok ? passed++ : failed++;
+}
+
+static void selftests(void)
+{
+    const unsigned all = LIGHTS_ALL, spot = LIGHT_BIT(LIGHT_SPOT);
+    expect("harness_passes_a_well_behaved_technique", OK_HALF, all, "contact", STAB_PASS, NULL);
+    expect("harness_counts_nan_outputs", GIVES_NAN, all, "contact", STAB_FAIL, "non-finite");
+    expect("harness_counts_out_of_range_outputs", GIVES_1_5, all, "contact", STAB_FAIL, "out-of-range");
+    expect("harness_reports_a_crash", CRASHES, all, "contact", STAB_FAIL, "crashed");
+    expect("harness_reports_a_hang", HANGS, all, "contact", STAB_FAIL, "no result within");
+    expect("harness_reports_a_sanitizer_error", OVERFLOWS, all, "contact", STAB_FAIL, "sanitizer report");
+    expect("harness_reports_a_leak", LEAKS, all, "contact", STAB_FAIL, "LeakSanitizer");
+    expect("harness_fails_an_unexpected_refusal", REFUSES, all, "contact", STAB_FAIL, "refuses every scene");
+    expect("harness_allows_a_refusal_where_documented", REFUSES, all, "light_inside_occluder", STAB_PASS, "allowed");
+    expect("harness_checks_the_hard_limit", ALWAYS_LIT, LIGHT_BIT(LIGHT_SPHERE), "light_size_1e-6", STAB_FAIL,
+           "does not converge");
+    expect("harness_marks_unhandled_lights_not_applicable", OK_HALF, spot, "light_size_1e-6", STAB_NOT_APPLICABLE,
+           "handles spot");
+    expect("harness_params_at_bounds_render", OK_HALF, all, "param_taps_m", STAB_PASS, "taps = ");
+    expect("harness_params_outside_are_refused_with_range", OK_HALF, all, "param_weight_above", STAB_PASS, NULL);
+    expect("harness_nonfinite_params_are_refused", OK_HALF, all, "param_taps_nonfinite", STAB_PASS, NULL);
+}
+
+/* The engine under the sanitizers on every extreme case: `hard` (the
+ * ray-traced limit, little code of its own) and the input cases. The
+ * registry's whole matrix runs on the optimised build (tests/run.sh). */
+static int sanitized, sanitized_failed;
+
+static void print_row(const StabResult *r, void *user)
+{
+    (void)user;
+    printf("%-4s %-6s %-34s %-13s %6.2f s  %s\n", stab_status_name(r->status), r->technique, r->case_name, r->light,
+           r->seconds, r->detail);
+    fflush(stdout);
+    if (r->status == STAB_PASS) sanitized++;
+    else if (r->status == STAB_FAIL) sanitized_failed++;
+}
+
+int main(void)
+{
+    selftests();
+    printf("harness: %d passed, %d failed\n", passed, failed);
+    fflush(stdout);
+    Error err;
+    const Technique *hard = tech_find("hard", &err);
+    char work[] = "/tmp/shadowlab-sanitized-XXXXXX";
+    StabOptions o = {true, 0, 0, NULL, work, NULL};
+    bool ran = hard && mkdtemp(work) && stab_run(&hard, 1, true, &o, print_row, NULL, &err);
+    if (!ran) printf("    %s\n", err.msg);
+    rmdir(work);
+    printf("sanitized: %d passed, %d failed\n", sanitized, sanitized_failed + !ran);
+    return failed || sanitized_failed || !ran ? 1 : 0;
+}
