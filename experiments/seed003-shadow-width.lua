@@ -20,9 +20,11 @@ local exp = experiment.new{
   name = "seed003-shadow-width", samples = 256, repeats = 3, warmup = 1,
   overrides = { ["camera.width"] = 320, ["camera.height"] = 240 },
   description = "Seed 003: shadow_width at 64^2 and 1024^2 with nearest and bilinear lookups (Fig. 7), with " ..
-                "the back-face depth map of §5, and across c_scale, beside sm and hard, on sphere-on-plane, " ..
+                "the back-face depth map of §5, and across c_scale, beside sm and hard, on ball-and-disk, " ..
+                "sphere-on-plane, " ..
                 "contact and overlap.",
 }
+exp:scene("scenes/ball-and-disk.lua") -- Fig. 7's setting: the map's texels spent on a ball and a disk
 exp:scene("scenes/sphere-on-plane.lua")
 exp:scene("scenes/contact.lua")
 exp:scene("scenes/overlap.lua")
