@@ -89,5 +89,16 @@ expect reference_irradiance 0 "irradiance" -- "$SL" reference "$SCENE" --measure
 expect render_without_png 0 "evaluate" -- "$SL" render "$SCENE" -t hard --no-png $SMALL -o "$TMP/nopng"
 if [ -e "$TMP/nopng/hard.png" ]; then no render_no_png_writes_none "png written"; else ok render_no_png_writes_none; fi
 
+# shadowlab aliasing: the sampling-error report of a technique's map (docs/aliasing.md)
+PLANE=$ROOT/scenes/overhead-plane.lua
+AL="$TMP/aliasing"
+expect aliasing_writes_outputs 0 "undersampled" "storage factor" -- "$SL" aliasing "$PLANE" -t pcf -p projection=lispsm -p fit=body -p cascades=2 $SMALL --frustum 6 -o "$AL"
+for f in aliasing.exr aliasing.json aliasing.png aliasing-cascade.png aliasing-hist.csv aliasing-depth.csv aliasing-axis.csv; do
+    if [ -s "$AL/$f" ]; then ok "aliasing_wrote_$f"; else no "aliasing_wrote_$f" "missing"; fi
+done
+expect aliasing_refuses_a_mapless_technique 2 "hard renders no shadow map" -- "$SL" aliasing "$PLANE" -t hard -o "$TMP/al-hard"
+expect aliasing_refuses_bad_frustum 2 "--frustum expects" -- "$SL" aliasing "$PLANE" --frustum -3 -o "$TMP/al-bad"
+expect aliasing_param_range 2 "cascades" "\[1, 16\]" -- "$SL" aliasing "$PLANE" -p cascades=17 -o "$TMP/al-bad"
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
