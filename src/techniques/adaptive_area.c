@@ -48,7 +48,10 @@ static const ParamDesc aa_params[] = {
 };
 
 static const char *const aa_resources[] = {"shadow_map", "minmax_pyramid", "light_image_sat", "view_samples", NULL};
-static const char *const aa_aux[] = {"level", NULL};
+/* level: the deepest subdivision reached (Table 2, Fig. 2); tests: the
+ * shadow-map tests the sample took (search and regions), the work that
+ * Table 1's frame rates measure, independent of the machine's load. */
+static const char *const aa_aux[] = {"level", "tests", NULL};
 
 typedef struct AaState {
     const ShadowMap *map;
@@ -187,10 +190,11 @@ static double search_depth(const AaState *st, const SmapReceiver *r, double z_re
 
 /* Average linear depth of the blockers the search taps find over the cone's
  * region at the search depth (seed 001 §3, after Annen et al.); 0 when none. */
-static double average_blocker_depth(const AaState *st, const SmapReceiver *r, double z_receiver)
+static double average_blocker_depth(const AaState *st, const SmapReceiver *r, double z_receiver, int *tests)
 {
     double z_search = search_depth(st, r, z_receiver);
     if (!(z_search > 0.0)) return 0.0;
+    *tests = st->search_taps * st->search_taps;
     Region g = {st, r, 1.0 / z_search - 1.0 / z_receiver};
     int n = st->search_taps, found = 0;
     double sum = 0.0;
@@ -230,16 +234,18 @@ static bool should_split(const AaState *st, int level, int node, double e)
 }
 
 /* The quad tree, depth first: accumulate leaf area x E x leaf colour into
- * sum[3]; returns the deepest level reached. */
-static int subdivide(const Region *g, double sum[3])
+ * sum[3]; returns the deepest level reached, and the nodes tested. */
+static int subdivide(const Region *g, double sum[3], int *nodes)
 {
     const AaState *st = g->st;
     int stack[3 * (3 * AA_MAX_LEVEL + 1)], top = 0, deepest = 0;
+    *nodes = 0;
     stack[top++] = 0; stack[top++] = 0; stack[top++] = 0; /* level, x, y */
     while (top > 0) {
         int y = stack[--top], x = stack[--top], level = stack[--top];
         int node = node_index(level, x, y);
         double e = node_visibility(g, level, x, y);
+        (*nodes)++;
         if (should_split(st, level, node, e)) {
             for (int c = 3; c >= 0; c--) {
                 stack[top++] = level + 1;
@@ -255,20 +261,23 @@ static int subdivide(const Region *g, double sum[3])
     return deepest;
 }
 
-/* Visibility of one receiver per channel (out[0..channels)); the level reached. */
-static int shade_receiver(const AaState *st, const SmapReceiver *r, int channels, float *out)
+/* Visibility of one receiver per channel (out[0..channels)); the level
+ * reached, and the shadow tests taken into *tests. */
+static int shade_receiver(const AaState *st, const SmapReceiver *r, int channels, float *out, int *tests)
 {
     for (int c = 0; c < channels; c++) out[c] = 1.0f;
+    *tests = 0;
     double z_p = r->mc.depth_linear;
     if (!(z_p > 0.0)) return 0;
-    double z_avg = average_blocker_depth(st, r, z_p);
+    double z_avg = average_blocker_depth(st, r, z_p, tests);
     if (!(z_avg > 0.0)) return 0; /* no blocker in the cone: lit */
     /* The plane of the average blocker: z_avg >= near > 0 and z_avg < z_p
      * (blockers lie in front of the biased receiver), so k >= 0; k -> 0 at
      * contact, where the region shrinks to the receiver's own texel. */
     Region g = {st, r, fmax(1.0 / z_avg - 1.0 / z_p, 0.0)};
     double sum[3] = {0, 0, 0};
-    int level = subdivide(&g, sum);
+    int nodes, level = subdivide(&g, sum, &nodes);
+    *tests += nodes * st->taps * st->taps;
     for (int c = 0; c < channels; c++) /* a channel the light does not emit has nothing to block */
         out[c] = st->light_color[c] > 0.0f ? (float)fmin(fmax(sum[c] / st->light_color[c], 0.0), 1.0) : 1.0f;
     return level;
@@ -281,12 +290,15 @@ static void aa_evaluate(const void *state, const TechContext *ctx, int begin, in
         if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
         float *o = out + (size_t)(s - begin) * (size_t)ctx->channels;
         SmapReceiver r;
-        int level = 0;
+        int level = 0, tests = 0;
         if (smap_receiver(st->map, &st->bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r))
-            level = shade_receiver(st, &r, ctx->channels, o);
+            level = shade_receiver(st, &r, ctx->channels, o, &tests);
         else
             tech_store(ctx, out, begin, s, 1.0f); /* outside the map nothing is known to block: lit */
-        if (ctx->aux) ctx->aux[s] = (float)level;
+        if (ctx->aux) {
+            ctx->aux[2 * (size_t)s] = (float)level;
+            ctx->aux[2 * (size_t)s + 1] = (float)tests;
+        }
     }
 }
 

@@ -96,7 +96,7 @@ TEST(test_adaptive_area_error_falls_with_subdivision_under_a_coloured_light)
         RenderResult r;
         Metrics m;
         CHECK(soft_render(lab, "adaptive_area", p, &r) && soft_metrics(lab, &r.visibility, REF_SAMPLES, &m));
-        CHECK(r.visibility.channels == 3 && r.aux.channels == 1);
+        CHECK(r.visibility.channels == 3 && r.aux.channels == 2);
         mae[level] = m.region[REGION_PENUMBRA].mae;
         printf("    fixed level %d: penumbra MAE %.4f (RGB, %ld samples)\n", level, mae[level],
                m.region[REGION_PENUMBRA].count);
@@ -141,8 +141,8 @@ TEST(test_adaptive_area_white_light_image_equals_the_single_colour_result)
     double worst = 0;
     for (long s = 0; s < count; s++) {
         for (int c = 0; c < 3; c++) worst = fmax(worst, fabs(r[1].visibility.data[3 * s + c] - r[0].visibility.data[s]));
-        CHECK(r[0].aux.data[s] == r[1].aux.data[s]);
-        split += r[0].aux.data[s] > 0;
+        CHECK(r[0].aux.data[2 * s] == r[1].aux.data[2 * s] && r[0].aux.data[2 * s + 1] == r[1].aux.data[2 * s + 1]);
+        split += r[0].aux.data[2 * s] > 0;
     }
     printf("    %ld samples (%ld subdivided): max |RGB - single colour| %.3g\n", count, split, worst);
     CHECK(split > 50);
