@@ -9,6 +9,9 @@
  *                   falls on the light, over the light's area in lexels;
  *   occlusion_bits  its first pseudo-code (Eq. 1): the lexels of D each
  *                   caster covers are marked, s = marked / |D| (set union).
+ * The default is the occlusion bits, the paper's definition: the additive
+ * sum point-samples each footprint by its centre, so once footprints outgrow
+ * the light (small lights) the hard shadow vanishes (docs/soft-maps.md).
  * Both keep one caster per lexel, the map's first layer (assumption 2; the
  * first pseudo-code's layered depth image would need every layer, and a
  * peeled second layer of a closed mesh is only its own back face).
@@ -31,9 +34,10 @@ static const ParamDesc acc_params[] = {
     {"K", PARAM_INT, 5, 1, ACC_MAX_K, "lexels",
      "kernel size: the K x K lexels visited around the receiver's own (seed 000: 5 for speed, 10 for quality)",
      NULL},
-    {"variant", PARAM_ENUM, VARIANT_ADDITIVE, 0, 1, "",
-     "additive (second pseudo-code, Eqs. 2-3: shadowing factors added) or occlusion_bits (first pseudo-code, "
-     "Eq. 1: union of the casters' footprints on the lexel grid)",
+    {"variant", PARAM_ENUM, VARIANT_OBITS, 0, 1, "",
+     "occlusion_bits (first pseudo-code, Eq. 1: union of the casters' footprints on the lexel grid) or additive "
+     "(second pseudo-code, Eqs. 2-3: shadowing factors added; the paper's GPU version, which loses the shadow of "
+     "lights smaller than its casters' footprints)",
      variant_names},
 };
 
@@ -172,7 +176,7 @@ static float visibility(const AccState *st, const SmapReceiver *r)
 {
     Frame fr;
     if (frame(st, r, &fr)) {
-        if (!softmap_may_block(&st->sm, r, fr.i0, fr.j0, fr.i0 + st->K - 1, fr.j0 + st->K - 1)) return 1.0f;
+        if (!softmap_may_block(&st->sm, r, fr.i0, fr.j0, fr.i0 + st->K - 1, fr.j0 + st->K - 1, NULL)) return 1.0f;
         if (st->variant == VARIANT_ADDITIVE) return (float)(1.0 - shadow_additive(st, r, &fr));
         bool empty;
         double s = shadow_obits(st, r, &fr, &empty);
@@ -201,7 +205,8 @@ const Technique tech_accumulation = {
     .family = "soft",
     .source = "seed 000 (Aszódi & Szirmay-Kalos, shadow accumulation) §1.1, Eqs. 1-4 and both pseudo-codes",
     .summary = "each lexel of a K x K neighbourhood is an elementary caster projected back from the receiver; "
-               "shadowing factors added (Eqs. 2-3) or united on the lexel grid (Eq. 1)",
+               "shadowing factors added (Eqs. 2-3) or united on the lexel grid (Eq. 1); R is the scene "
+               "light's own size",
     .params = acc_params,
     .num_params = (int)(sizeof acc_params / sizeof acc_params[0]),
     .resources = acc_resources,

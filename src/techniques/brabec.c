@@ -11,9 +11,10 @@
  * edge of a blocker at z_b casts a penumbra of half-width
  *     w = a (z_p - z_b) / (z_p z_b)            (tangent units, a = light radius),
  * centred on the hard edge (the same similar triangles as PCSS's window,
- * course §5.2.2), so with tau = 1/2 + d / (2 w) outside and 1/2 - d / (2 w)
- * inside, visibility is Parker's Bernstein interpolant 3 tau^2 - 2 tau^3
- * (seed 002 §3) or tau. The search stops at the first texel found, at the
+ * course §5.2.2; a rect light counts as the disk of its area), so with
+ * tau = 1/2 + d / (2 w) outside and 1/2 - d / (2 w) inside, visibility is
+ * Parker's Bernstein interpolant 3 tau^2 - 2 tau^3 (seed 002 §3) or tau.
+ * The search stops at the first texel found, at the
  * widest penumbra any blocker beyond the near plane can cast, or at the
  * search radius (course §5.2.1's failure: occluders beyond it are ignored).
  * Blockers of the receiver's own object do not count unless self_shadow is
@@ -94,7 +95,8 @@ static bool make_offsets(BrabecState *st, int radius, Error *err)
 static bool make_object_table(BrabecState *st, const Scene *scene, Error *err)
 {
     int total = 0;
-    for (int k = 0; k < scene->num_objects; k++) total += scene->objects[k].caster ? scene->objects[k].mesh.num_triangles : 0;
+    for (int k = 0; k < scene->num_objects; k++)
+        if (scene->objects[k].caster) total += scene->objects[k].mesh.num_triangles;
     st->object_of_triangle = malloc(sizeof *st->object_of_triangle * (size_t)(total > 0 ? total : 1));
     if (!st->object_of_triangle) return error_set(err, "out of memory");
     int t = 0;
@@ -169,6 +171,31 @@ static double falloff(int kind, double tau)
     return kind == FALLOFF_SMOOTH ? tau * tau * (3.0 - 2.0 * tau) : tau;
 }
 
+/* Texel centres within w + slack of p's own texel's hold every texel whose
+ * edge lies within w of p: half a texel to the edge, and p is up to a half
+ * diagonal from its texel's centre. */
+static double search_slack(const SoftFace *f) { return 0.5 * fmin(f->dx, f->dy) + 0.71 * fmax(f->dx, f->dy); }
+
+/* How far a lit receiver's blocker can be (tangent units, texel centres):
+ * the widest penumbra a blocker beyond the near plane casts, narrowed twice
+ * through the nearest depth the pyramid finds within it (course §5.2.3.4's
+ * search area through z_min); false when nothing in reach can block. */
+static bool outer_limit(const BrabecState *st, const SmapReceiver *r, double a, double *limit)
+{
+    const SoftFace *f = &st->sm.face[r->mc.face];
+    double z_p = r->mc.depth_linear, z_near = f->near_world, slack = search_slack(f);
+    int i, j;
+    smap_texel(r, &i, &j);
+    for (int pass = 0; pass < 3; pass++) {
+        *limit = fmin(half_width(a, z_p, z_near), st->search_tangent) + slack;
+        int ri = (int)ceil(*limit / f->dx), rj = (int)ceil(*limit / f->dy); /* the offsets nearest() may visit */
+        double z_min;
+        if (!softmap_may_block(&st->sm, r, i - ri, j - rj, i + ri, j + rj, &z_min)) return false;
+        z_near = fmax(z_near, z_min);
+    }
+    return true;
+}
+
 static float visibility(const BrabecState *st, const SmapReceiver *r, int object)
 {
     const SoftFace *f = &st->sm.face[r->mc.face];
@@ -176,17 +203,14 @@ static float visibility(const BrabecState *st, const SmapReceiver *r, int object
     int i, j;
     smap_texel(r, &i, &j);
     if (!blocked(st, r, object, i, j)) { /* outer penumbra: the nearest blocker */
-        double limit = fmin(half_width(a, z_p, z_n), st->search_tangent) + 0.5 * fmin(f->dx, f->dy);
-        int ri = (int)ceil(limit / f->dx), rj = (int)ceil(limit / f->dy); /* the offsets nearest() may visit */
-        if (!softmap_may_block(&st->sm, r, i - ri, j - rj, i + ri, j + rj) ||
-            !nearest(st, r, object, true, limit, &edge, &i, &j))
-            return 1.0f;
+        double limit;
+        if (!outer_limit(st, r, a, &limit) || !nearest(st, r, object, true, limit, &edge, &i, &j)) return 1.0f;
         double w = half_width(a, z_p, fmax(softmap_depth(&st->sm, r->mc.face, i, j), z_n));
         return w > 0.0 ? (float)falloff(st->falloff, 0.5 + edge / (2.0 * w)) : 1.0f;
     }
     /* inner penumbra: p's own blocker sets the width, the nearest unblocked texel the place */
     double w = half_width(a, z_p, fmax(softmap_depth(&st->sm, r->mc.face, i, j), z_n));
-    double limit = fmin(w, st->search_tangent) + 0.5 * fmin(f->dx, f->dy);
+    double limit = fmin(w, st->search_tangent) + search_slack(f);
     if (!(w > 0.0) || !nearest(st, r, object, false, limit, &edge, &i, &j)) return 0.0f;
     return (float)falloff(st->falloff, 0.5 - edge / (2.0 * w));
 }

@@ -1,6 +1,8 @@
 /* pcss.c -- `pcss`: percentage-closer soft shadows (Fernando 2005; course
  * §5.2.2). In the face's tangent frame (softmap.h), for a receiver at depth
- * z_p and a light of half-extent a (world, along each map axis):
+ * z_p and a light of half-extent a along each map axis (w_light = 2a; sphere
+ * and disk: a = R; rect: its bounding box in the map's axes, exact when it is
+ * aligned with them):
  *   1. blocker search over the region the light-receiver pyramid cuts on the
  *      near plane z_n, half-width a (z_p - z_n) / (z_p z_n) in tangent units;
  *      blockers are texels closer than the receiver (course §2.1's test with
@@ -129,7 +131,7 @@ static bool blocker_depth(const PcssState *st, const SmapReceiver *r, Window w, 
 {
     Blockers b = {0, 0.0};
     if (!softmap_may_block(&st->sm, r, (int)floor(r->mc.s - w.hx), (int)floor(r->mc.t - w.hy),
-                           (int)floor(r->mc.s + w.hx), (int)floor(r->mc.t + w.hy)))
+                           (int)floor(r->mc.s + w.hx), (int)floor(r->mc.t + w.hy), NULL))
         return false;
     if (st->sampling == SAMPLING_EXHAUSTIVE) { /* every texel whose centre lies in the window */
         int i0 = (int)ceil(r->mc.s - w.hx - 0.5), i1 = (int)floor(r->mc.s + w.hx - 0.5);

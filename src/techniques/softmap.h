@@ -54,8 +54,11 @@ bool softmap_init(SoftMap *sm, ResourceManager *rm, const ShadowMap *map, const 
  * pyramid's minimum depth over the window is no closer than the largest
  * reference depth over it (course §5.2.3.4's early out, z_p <= z_min: lit).
  * The reference is affine in (s, t), or its reciprocal is, so its largest
- * value over the window is at a corner. Exact: it never skips a blocker. */
-bool softmap_may_block(const SoftMap *sm, const SmapReceiver *r, int i0, int j0, int i1, int j1);
+ * value over the window is at a corner. Exact: it never skips a blocker.
+ * z_min_linear (may be NULL) receives a lower bound of every depth in the
+ * window (world units), for searches that narrow through it. */
+bool softmap_may_block(const SoftMap *sm, const SmapReceiver *r, int i0, int j0, int i1, int j1,
+                       double *z_min_linear);
 
 /* Linear depth (world units along the face's axis) of texel (i, j);
  * +INFINITY where no caster was drawn. */

@@ -75,8 +75,8 @@ TEST(test_soft_maps_stay_finite_at_contact)
     for (int c = 0; c < NUM_CONFIGS; c++)
         for (int biased = 0; biased < 2; biased++) {
             const char *p[] = {configs[c][1] ? configs[c][1] : "map_size=512", "map_size=512",
-                               biased ? "slope_bias=1" : "slope_bias=0", biased ? "receiver_plane=true" : "receiver_plane=false",
-                               NULL};
+                               biased ? "slope_bias=1" : "slope_bias=0",
+                               biased ? "receiver_plane=true" : "receiver_plane=false", NULL};
             RenderResult r;
             CHECK(soft_render(lab, configs[c][0], p, &r));
             long bad = 0, lit = 0;
@@ -86,7 +86,8 @@ TEST(test_soft_maps_stay_finite_at_contact)
                 bad += !(v >= 0.0f && v <= 1.0f); /* NaN fails both */
                 lit++;
             }
-            CHECK_MSG(bad == 0, "%s %s %s: %ld of %ld values not finite in [0, 1]", configs[c][0], p[0], p[2], bad, lit);
+            CHECK_MSG(bad == 0, "%s %s %s: %ld of %ld values not finite in [0, 1]", configs[c][0], p[0], p[2], bad,
+                      lit);
             render_result_free(&r);
         }
     lab_close(lab);
@@ -130,7 +131,8 @@ TEST(test_soft_maps_fail_on_overlap_as_their_papers_predict)
         CHECK_MSG(rms > cases[c].bound + m.noise_rms, "%s: RMSE %.4f not above its bound %.3f", cases[c].tech, rms,
                   cases[c].bound);
         if (strcmp(cases[c].tech, "accumulation") == 0)
-            CHECK_MSG(ue->leak_mean > 0.05, "accumulation's umbra is not lighter than expected (leak %.4f)", ue->leak_mean);
+            CHECK_MSG(ue->leak_mean > 0.05, "accumulation's umbra is not lighter than expected (leak %.4f)",
+                      ue->leak_mean);
         render_result_free(&r);
     }
     lab_close(lab);
