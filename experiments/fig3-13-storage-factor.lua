@@ -17,14 +17,10 @@
 -- plots/behind.*, summary.md.
 local sl = require "shadowlab"
 local plot = require "shadowlab.plot"
+local flags = require "shadowlab.flags"
 
-local out, points = "reports/fig3-13", 24
-local i = 1
-while arg[i] do
-  if arg[i] == "--out" then out = arg[i + 1]; i = i + 2
-  elseif arg[i] == "--points" then points = math.tointeger(tonumber(arg[i + 1])); i = i + 2
-  else error("fig3-13: unknown argument " .. arg[i] .. " (--out DIR, --points N)", 0) end
-end
+local opt = flags.parse(arg, { out = "reports/fig3-13", points = 24 }, "fig3-13")
+local out, points = opt.out, math.tointeger(opt.points)
 
 local LIGHTS = { { name = "overhead", dir = { 0, -1, 0 }, label = "overhead light" },
                  { name = "behind", dir = { 0, 0, -1 }, label = "light behind the viewer" } }

@@ -16,14 +16,10 @@
 -- 1 + 4 / map_size), divided out for the deviations.
 local sl = require "shadowlab"
 local plot = require "shadowlab.plot"
+local flags = require "shadowlab.flags"
 
-local out, res = "reports/fig3-7", 1024
-local i = 1
-while arg[i] do
-  if arg[i] == "--out" then out = arg[i + 1]; i = i + 2
-  elseif arg[i] == "--map-size" then res = math.tointeger(tonumber(arg[i + 1])); i = i + 2
-  else error("fig3-7: unknown argument " .. arg[i] .. " (--out DIR, --map-size N)", 0) end
-end
+local opt = flags.parse(arg, { out = "reports/fig3-7", ["map-size"] = 1024 }, "fig3-7")
+local out, res = opt.out, math.tointeger(opt["map-size"])
 
 local lab <close> = sl.open("scenes/overhead-plane.lua")
 local probe = lab:aliasing{ params = { projection = "ortho", fit = "body", map_size = res } }
