@@ -13,18 +13,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-#include "core/fsutil.h"
-#include "core/machine.h"
+#include "bench.h"
 #include "core/timer.h"
 #include "lab/lab.h"
-#include "version.h"
 
 #define PACKET 16
 #define SEED 1u
 #define PATTERN SAMPLING_R2
-#define CSV_HEADER                                                                                              \
-    "scene,triangles,samples,threads,rays,bare_rays_per_s,reference_rays_per_s,ratio,commit,cpu_model,date\n"
+#define CSV_HEADER "scene,triangles,samples,rays,bare_rays_per_s,reference_rays_per_s,ratio," BENCH_TAIL_HEADER "\n"
 
 typedef struct Options {
     const char *scene, *csv;
@@ -54,15 +50,6 @@ static int usage(const char *msg)
     return 1;
 }
 
-static bool parse_int(const char *s, int lo, int hi, int *out)
-{
-    char *end;
-    long v = s ? strtol(s, &end, 10) : 0;
-    if (!s || end == s || *end != '\0' || v < lo || v > hi) return false;
-    *out = (int)v;
-    return true;
-}
-
 static bool parse_options(int argc, char **argv, Options *o)
 {
     *o = (Options){"scenes/sphere-on-plane.lua", "reports/bench/reference_throughput.csv", 256,
@@ -70,9 +57,9 @@ static bool parse_options(int argc, char **argv, Options *o)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         bool ok;
-        if (strcmp(a, "-n") == 0) ok = parse_int(v, 1, REFERENCE_MAX_SAMPLES, &o->samples);
-        else if (strcmp(a, "--threads") == 0) ok = parse_int(v, 1, 1024, &o->threads);
-        else if (strcmp(a, "--repeat") == 0) ok = parse_int(v, 1, 1000, &o->repeat);
+        if (strcmp(a, "-n") == 0) ok = bench_parse_int(v, 1, REFERENCE_MAX_SAMPLES, &o->samples);
+        else if (strcmp(a, "--threads") == 0) ok = bench_parse_int(v, 1, 1024, &o->threads);
+        else if (strcmp(a, "--repeat") == 0) ok = bench_parse_int(v, 1, 1000, &o->repeat);
         else if (strcmp(a, "-o") == 0) ok = (o->csv = v) != NULL;
         else if (a[0] != '-') { o->scene = a; continue; }
         else return false;
@@ -243,60 +230,15 @@ static bool measure(const Inputs *in, const Options *o, Result *res, Error *err)
 
 /* ---- the record --------------------------------------------------------- */
 
-/* A CSV field, quoted when it holds a comma, quote or newline. */
-static void csv_field(FILE *fp, const char *s)
-{
-    if (!strpbrk(s, ",\"\n")) { fputs(s, fp); return; }
-    fputc('"', fp);
-    for (; *s; s++) {
-        if (*s == '"') fputc('"', fp);
-        fputc(*s, fp);
-    }
-    fputc('"', fp);
-}
-
-static void write_row(FILE *fp, const Inputs *in, const Options *o, const Result *r)
-{
-    char cpu[256], date[32];
-    time_t now = time(NULL);
-    strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
-    machine_cpu_model(cpu, sizeof cpu);
-    csv_field(fp, in->scene->name);
-    fprintf(fp, ",%d,%d,%d,%lld,%.0f,%.0f,%.4f,", in->scene->num_triangles, o->samples, o->threads, in->rays,
-            in->rays / r->bare_s, in->rays / r->ref_s, r->ratio);
-    csv_field(fp, SHADOWLAB_COMMIT);
-    fputc(',', fp);
-    csv_field(fp, cpu);
-    fprintf(fp, ",%s\n", date);
-}
-
-/* Rows already in the file, if it has this header; a file with another header is replaced. */
-static char *previous_rows(const char *path)
-{
-    if (!file_exists(path)) return NULL;
-    Error ignored;
-    char *text = file_read_all(path, NULL, &ignored);
-    if (text && strncmp(text, CSV_HEADER, strlen(CSV_HEADER)) == 0) return text;
-    fprintf(stderr, "bare_embree: note: %s has another header; starting it afresh\n", path);
-    free(text);
-    return NULL;
-}
-
-/* Add one row: the old rows plus the new one go to a fresh file, renamed into place. */
+/* Add one row to the CSV (bench.h: earlier rows kept under the same header). */
 static bool append_csv(const char *path, const Inputs *in, const Options *o, const Result *r, Error *err)
 {
-    char dir[4096];
-    snprintf(dir, sizeof dir, "%s", path);
-    char *slash = strrchr(dir, '/');
-    if (slash) *slash = '\0';
-    if (slash && !mkdir_p(dir, err)) return false;
-    char *old = previous_rows(path);
-    AtomicFile af;
-    if (!atomic_open(&af, path, err)) { free(old); return false; }
-    fputs(old ? old : CSV_HEADER, af.fp);
-    free(old);
-    write_row(af.fp, in, o, r);
-    return atomic_commit(&af, err);
+    char row[1024], name[160], tail[512];
+    bench_csv_field(name, sizeof name, in->scene->name);
+    bench_tail(tail, sizeof tail, o->threads);
+    snprintf(row, sizeof row, "%s,%d,%d,%lld,%.0f,%.0f,%.4f,%s\n", name, in->scene->num_triangles, o->samples,
+             in->rays, in->rays / r->bare_s, in->rays / r->ref_s, r->ratio, tail);
+    return bench_csv_append(path, CSV_HEADER, row, err);
 }
 
 static void print_summary(const Inputs *in, const Options *o, const Result *r)
@@ -312,7 +254,7 @@ static bool bench(const Options *o, Error *err)
     Lab *lab = lab_open(o->scene, NULL, 0, err);
     if (!lab) return false;
     Inputs in;
-    Result r;
+    Result r = {0};
     bool ok = load_inputs(lab, o, &in, err) && measure(&in, o, &r, err);
     if (ok) {
         print_summary(&in, o, &r);

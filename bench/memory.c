@@ -1,0 +1,140 @@
+/* memory.c -- peak resident memory against the resources' bytes (issue 8,
+ * item 6): every registered technique with a map_size, at map_size = 4096,
+ * one face (projection=perspective), rendered once in a child process of its own; the child's peak RSS
+ * (getrusage's ru_maxrss) against the bytes the resource manager reports
+ * holding (rm_bytes: what the records list, the BVH, view samples and
+ * classes included), target <= 1.2. The RSS before the scene is loaded (the
+ * program and its libraries) is reported beside it. Rows: DIR/memory.csv.
+ * Usage: memory [-t TECH]... [--res R] [--threads N] [-o DIR] [SCENE] */
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include "bench.h"
+
+#define MAX_ITEMS 32
+#define MEMORY_BOUND 1.2
+#define HEADER "technique,map_res,peak_rss_mib,resources_mib,ratio,bound,within,baseline_rss_mib,scene," \
+               BENCH_TAIL_HEADER "\n"
+
+typedef struct Options {
+    const char *scene, *dir, *techs[MAX_ITEMS];
+    int num_techs, res, threads;
+} Options;
+
+/* What a child reports back. */
+typedef struct Usage {
+    double peak_kib, baseline_kib, resources_bytes;
+    char error[256];
+} Usage;
+
+static double peak_kib(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_maxrss; /* KiB on Linux */
+}
+
+/* In the child: load, render once, measure. */
+static Usage child_run(const Options *o, const Technique *t)
+{
+    Usage u = {.baseline_kib = peak_kib()};
+    Error err = {0};
+    double params[TECH_MAX_PARAMS];
+    tech_params_default(t, params);
+    params[tech_param_index(t, "map_size")] = o->res;
+    int proj = tech_param_index(t, "projection"); /* one face: a sphere light's default may be a six-face cube */
+    if (proj >= 0) params[proj] = MAP_PROJ_PERSPECTIVE;
+    Lab *lab = lab_open(o->scene, NULL, 0, &err);
+    RenderRequest req = {.tech = t, .params = params, .light_index = 0, .repeat = 1};
+    RenderResult r;
+    if (lab && lab_render(lab, &req, &r, &err)) {
+        u.resources_bytes = (double)rm_bytes(lab_resources(lab));
+        u.peak_kib = peak_kib();
+        render_result_free(&r);
+    } else {
+        snprintf(u.error, sizeof u.error, "%s", err.msg);
+    }
+    lab_close(lab);
+    return u;
+}
+
+static bool measure(const Options *o, const Technique *t, Usage *u, Error *err)
+{
+    int fd[2];
+    if (pipe(fd) != 0) return error_set(err, "pipe failed");
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid < 0) return error_set(err, "fork failed");
+    if (pid == 0) {
+        close(fd[0]);
+        Usage c = child_run(o, t);
+        ssize_t w = write(fd[1], &c, sizeof c);
+        _exit(w == (ssize_t)sizeof c ? 0 : 1);
+    }
+    close(fd[1]);
+    ssize_t n = read(fd[0], u, sizeof *u);
+    close(fd[0]);
+    int status;
+    waitpid(pid, &status, 0);
+    if (n != (ssize_t)sizeof *u || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        return error_set(err, "%s: the measuring child failed", t->name);
+    if (u->error[0]) return error_set(err, "%s: %s", t->name, u->error);
+    return true;
+}
+
+static bool bench_tech(const Options *o, const Technique *t, Error *err)
+{
+    Usage u;
+    if (!measure(o, t, &u, err)) return false;
+    double peak = u.peak_kib / 1024.0, res = u.resources_bytes / 1048576.0, ratio = peak / res;
+    bool within = ratio <= MEMORY_BOUND;
+    printf("  %-16s %d^2: peak RSS %8.1f MiB, resources %8.1f MiB, ratio %.3f (bound %.1f; %.1f MiB before loading)%s\n",
+           t->name, o->res, peak, res, ratio, MEMORY_BOUND, u.baseline_kib / 1024.0, within ? "" : "  OVER");
+    char row[1024], tail[512], path[4096];
+    bench_tail(tail, sizeof tail, o->threads);
+    snprintf(row, sizeof row, "%s,%d,%.2f,%.2f,%.3f,%.1f,%s,%.2f,%s,%s\n", t->name, o->res, peak, res, ratio,
+             MEMORY_BOUND, within ? "yes" : "no", u.baseline_kib / 1024.0, o->scene, tail);
+    snprintf(path, sizeof path, "%s/memory.csv", o->dir);
+    return bench_csv_append(path, HEADER, row, err);
+}
+
+static bool wanted(const Options *o, const Technique *t)
+{
+    if (tech_param_index(t, "map_size") < 0) return false; /* no map to size */
+    for (int i = 0; i < o->num_techs; i++)
+        if (strcmp(o->techs[i], t->name) == 0) return true;
+    return o->num_techs == 0;
+}
+
+int main(int argc, char **argv)
+{
+    Options o = {.scene = "scenes/sphere-on-plane.lua", .dir = "reports/bench", .res = 4096,
+                 .threads = omp_get_max_threads()};
+    for (int i = 1; i < argc; i++) {
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        bool ok = true;
+        if (strcmp(argv[i], "-t") == 0 && v && o.num_techs < MAX_ITEMS) o.techs[o.num_techs++] = argv[++i];
+        else if (strcmp(argv[i], "--res") == 0) ok = bench_parse_int(v, 16, 16384, &o.res) && ++i;
+        else if (strcmp(argv[i], "--threads") == 0) ok = bench_parse_int(v, 1, 256, &o.threads) && ++i;
+        else if (strcmp(argv[i], "-o") == 0 && v) o.dir = argv[++i];
+        else if (argv[i][0] != '-') o.scene = argv[i];
+        else ok = false;
+        if (!ok) {
+            fprintf(stderr, "usage: memory [-t TECH]... [--res R] [--threads N] [-o DIR] [SCENE]\n");
+            return 2;
+        }
+    }
+    omp_set_num_threads(o.threads);
+    rt_set_threads(o.threads);
+    Error err;
+    for (int i = 0; i < tech_count(); i++)
+        if (wanted(&o, tech_at(i)) && !bench_tech(&o, tech_at(i), &err)) {
+            fprintf(stderr, "memory: %s\n", err.msg);
+            return 1;
+        }
+    return 0;
+}

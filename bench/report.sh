@@ -1,0 +1,159 @@
+#!/bin/sh
+# report.sh -- reports/bench/README.md from the CSVs run.sh wrote: one table
+# per bench (the columns that carry the figures, then threads, load and
+# commit), and gnuplot plots (SVG and PNG, with their .gp scripts and .dat
+# data): llvmpipe speed-ups against map size, cost growth per axis, and
+# thread speed-ups per technique, each with its target drawn in.
+# Usage: bench/report.sh DIR
+set -eu
+dir=${1:-reports/bench}
+md="$dir/README.md"
+
+# table CSV COLUMNS...: a markdown table of the named columns of CSV.
+table() {
+    f="$dir/$1"; name=$1; shift
+    [ -f "$f" ] || { echo "(not run: $name missing)"; echo; return; }
+    awk -F, -v cols="$*" '
+        function split_csv(line, out,    n, i, c, q, field) {
+            n = 0; field = ""; q = 0
+            for (i = 1; i <= length(line); i++) {
+                c = substr(line, i, 1)
+                if (c == "\"") { q = !q; continue }
+                if (c == "," && !q) { out[++n] = field; field = ""; continue }
+                field = field c
+            }
+            out[++n] = field
+            return n
+        }
+        NR == 1 {
+            n = split_csv($0, head); m = split(cols, want, " ")
+            for (k = 1; k <= m; k++) for (i = 1; i <= n; i++) if (head[i] == want[k]) idx[k] = i
+            line = "|"; sep = "|"
+            for (k = 1; k <= m; k++) { line = line " " want[k] " |"; sep = sep "---|" }
+            print line; print sep; next
+        }
+        {
+            split_csv($0, f); line = "|"
+            for (k = 1; k <= m; k++) line = line " " f[idx[k]] " |"
+            print line
+        }' "$f"
+    echo
+}
+
+# column CSV NAME...: the named columns, space-separated, for gnuplot.
+column() {
+    f="$1"; shift
+    awk -F, -v cols="$*" 'NR == 1 { m = split(cols, want, " "); for (k = 1; k <= m; k++) for (i = 1; i <= NF; i++)
+                                        if ($i == want[k]) idx[k] = i; next }
+                          { line = ""; for (k = 1; k <= m; k++) line = line (k > 1 ? " " : "") $(idx[k]); print line }' "$f"
+}
+
+# plot NAME SCRIPT: run a gnuplot script into NAME.svg and NAME.png.
+plot() {
+    printf '%s\n' "$2" > "$dir/$1.gp"
+    for t in svg png; do
+        case $t in svg) term="svg size 800,500 dynamic";; png) term="pngcairo size 800,500";; esac
+        gnuplot -e "set terminal $term; set output '$dir/$1.$t'" "$dir/$1.gp" 2>/dev/null ||
+            echo "report: note: gnuplot could not draw $1.$t" >&2
+    done
+}
+
+plots() {
+    if [ -f "$dir/llvmpipe_depth.csv" ]; then
+        for s in $(column "$dir/llvmpipe_depth.csv" scene | sort -u); do
+            column "$dir/llvmpipe_depth.csv" scene res speedup | awk -v s="$s" '$1 == s { print $2, $3 }' > "$dir/llvmpipe_$s.dat"
+        done
+        plot llvmpipe_depth "set title 'Depth-only shadow map: speed-up over llvmpipe (same threads)'
+set xlabel 'map size (texels per side)'; set ylabel 'llvmpipe time / shadowlab time'; set logscale x 2; set grid
+set yrange [0:*]
+plot $(for s in $(column "$dir/llvmpipe_depth.csv" scene | sort -u); do printf "'%s' using 1:2 with linespoints title '%s', " "$dir/llvmpipe_$s.dat" "$s"; done) 2 with lines dashtype 2 title 'target 2x'"
+    fi
+    if [ -f "$dir/growth.csv" ]; then
+        for axis in map_size triangles image_width; do
+            script="set title 'Frame time against $axis (1 thread)'
+set xlabel '$axis'; set ylabel 'frame time (ms)'; set logscale xy; set grid; set key outside right
+plot "
+            first=1
+            for t in $(column "$dir/growth.csv" technique | sort -u); do
+                column "$dir/growth.csv" technique axis value frame_ms |
+                    awk -v t="$t" -v a="$axis" '$1 == t && $2 == a { print $3, $4 }' > "$dir/growth_${axis}_$t.dat"
+                [ -s "$dir/growth_${axis}_$t.dat" ] || { rm -f "$dir/growth_${axis}_$t.dat"; continue; }
+                [ $first = 1 ] || script="$script, "
+                script="$script'$dir/growth_${axis}_$t.dat' using 1:2 with linespoints title '$t'"
+                first=0
+            done
+            plot "growth_$axis" "$script"
+        done
+        script="set title 'Frame time against each technique''s main parameter, relative to its first value (1 thread)'
+set xlabel 'parameter value / first value'; set ylabel 'frame time / frame time at the first value'
+set logscale xy; set grid; set key outside right
+plot "
+        first=1
+        for t in $(column "$dir/growth.csv" technique | sort -u); do
+            column "$dir/growth.csv" technique axis value frame_ms |
+                awk -v t="$t" '$1 == t && $2 != "map_size" && $2 != "triangles" && $2 != "image_width" {
+                    if (!v0) { v0 = $3; f0 = $4; name = $2 } print $3 / v0, $4 / f0, name }' > "$dir/growth_main_$t.dat"
+            [ -s "$dir/growth_main_$t.dat" ] || { rm -f "$dir/growth_main_$t.dat"; continue; }
+            p=$(awk 'NR == 1 { print $3 }' "$dir/growth_main_$t.dat")
+            [ $first = 1 ] || script="$script, "
+            script="$script'$dir/growth_main_$t.dat' using 1:2 with linespoints title '$t ($p)'"
+            first=0
+        done
+        [ $first = 1 ] || plot growth_main "$script"
+    fi
+    if [ -f "$dir/threads_eval.csv" ]; then
+        column "$dir/threads_eval.csv" technique speedup > "$dir/threads_eval.dat"
+        plot threads_eval "set title 'Speed-up from 1 thread to $(column "$dir/threads_eval.csv" threads | head -1) threads'
+set style fill solid 0.5; set boxwidth 0.7; set ylabel 'speed-up'; set yrange [0:*]; set grid y
+set xtics rotate by -45
+plot '$dir/threads_eval.dat' using 0:2:xtic(1) with boxes notitle, 1.8 with lines dashtype 2 title 'target 1.8'"
+    fi
+}
+
+{
+    echo "# shadowlab benchmarks"
+    echo
+    echo "Written by \`make bench\` (bench/run.sh, bench/report.sh); what each figure means and its target"
+    echo "are in bench/README.md. Load at the start and the end of the run:"
+    echo
+    sed 's/^/    /' "$dir/load.txt" 2>/dev/null || true
+    echo
+    echo "## 1. Reference throughput against a bare Embree loop (target ratio >= 0.9)"
+    echo
+    table reference_throughput.csv scene triangles samples rays bare_rays_per_s reference_rays_per_s ratio threads load_1min commit
+    echo "Seed 002's overhead, single_sample_rt / hard:"
+    echo
+    table single_sample_overhead.csv scene radius shadow_ratio ray_tracer_ratio threads commit
+    echo "## 2. Against llvmpipe (target speed-up >= 2)"
+    echo
+    echo "![speed-up over llvmpipe](llvmpipe_depth.svg)"
+    echo
+    table llvmpipe_depth.csv scene triangles res llvmpipe_ms shadowlab_ms speedup coverage_mismatch depth_mismatch max_depth_diff agree threads load_1min commit
+    table llvmpipe_pcf.csv scene width height map_res K llvmpipe_ms shadowlab_ms speedup mae samples_off agree threads load_1min commit
+    echo "## 3. Cost growth"
+    echo
+    echo "![main parameter](growth_main.svg) ![map size](growth_map_size.svg)"
+    echo "![triangles](growth_triangles.svg) ![image size](growth_image_width.svg)"
+    echo
+    table growth.csv technique axis value frame_ms eval_ms build_ms resources_built threads load_1min
+    echo "Constant time in K with summed-area tables (target: largest K within 1.2x of the smallest):"
+    echo
+    table constant_time.csv technique prefilter K_min K_max frame_min_ms frame_max_ms ratio within threads load_1min
+    echo "## 4. Sweep reuse (target <= 1.1; cached references not retraced)"
+    echo
+    table sweep_reuse.csv sweep technique points sweep_ms one_build_ms evals_ms ratio builds reuses within threads load_1min
+    echo "## 5. Thread scaling (target >= 1.8)"
+    echo
+    echo "![thread speed-ups](threads_eval.svg)"
+    echo
+    table raster_threads.csv scene triangles res ms_1 ms_n speedup threads load_1min
+    table threads_eval.csv technique ms_1 ms_n speedup width height threads load_1min
+    echo "## 6. Peak memory, 4096^2 maps (target <= 1.2)"
+    echo
+    table memory.csv technique map_res peak_rss_mib resources_mib ratio within baseline_rss_mib load_1min
+    echo "## 7. Start-up (target: no OpenImageIO, first line under 20 ms)"
+    echo
+    table startup.csv command first_line_ms exit_ms loads_openimageio within load_1min
+} > "$md"
+plots
+echo "report: $md"
