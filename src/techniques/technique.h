@@ -21,7 +21,7 @@ typedef struct ParamDesc {
     const char *const *choices;  /* PARAM_ENUM: NULL-terminated names, value = index */
 } ParamDesc;
 
-#define TECH_MAX_PARAMS 32
+#define TECH_MAX_PARAMS 64
 
 /* Light kinds a technique handles, as a bit set of LightKind. */
 #define LIGHT_BIT(kind) (1u << (kind))
