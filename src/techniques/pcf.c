@@ -84,13 +84,32 @@ static bool pcf_prepare(const TechContext *ctx, void **state, Error *err)
     return true;
 }
 
+/* Lit taps of row j (clamped to the edge, like shadowmap_texel) over
+ * columns [i0, i0 + K) against one reference depth: smap_lit's test with the
+ * row addressed once and no per-tap branch, so the interior loop vectorises. */
+static int box_row_lit(const ShadowMap *m, int face, int i0, int j, int K, double ref)
+{
+    int res = m->res, jc = j < 0 ? 0 : j >= res ? res - 1 : j, lit = 0;
+    const float *row = m->depth + ((size_t)face * (size_t)res + (size_t)jc) * (size_t)res;
+    if (i0 >= 0 && i0 + K <= res) {
+        for (int i = i0; i < i0 + K; i++) lit += !(ref > row[i]);
+        return lit;
+    }
+    for (int i = i0; i < i0 + K; i++) lit += !(ref > row[i < 0 ? 0 : i >= res ? res - 1 : i]);
+    return lit;
+}
+
 /* Box: K x K texel centres around (s, t); the first is at floor(s - K/2 + 1/2). */
 static float filter_box(const PcfState *st, const SmapReceiver *r)
 {
     int i0 = (int)floor(r->mc.s - 0.5 * st->K + 0.5), j0 = (int)floor(r->mc.t - 0.5 * st->K + 0.5);
     float lit = 0.0f;
-    for (int j = j0; j < j0 + st->K; j++)
-        for (int i = i0; i < i0 + st->K; i++) lit += smap_lit(st->map, r, i, j);
+    if (r->plane) { /* a reference per texel (receiver-plane bias) */
+        for (int j = j0; j < j0 + st->K; j++)
+            for (int i = i0; i < i0 + st->K; i++) lit += smap_lit(st->map, r, i, j);
+    } else {
+        for (int j = j0; j < j0 + st->K; j++) lit += (float)box_row_lit(st->map, r->mc.face, i0, j, st->K, r->ref);
+    }
     return lit / (float)(st->K * st->K);
 }
 
