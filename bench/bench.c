@@ -1,5 +1,6 @@
 /* bench.c -- the bench programs' shared CSV rows and helpers (bench.h). */
 #include "bench.h"
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -128,4 +129,45 @@ const ShadowMap *bench_map(Lab *lab, int res, Error *err)
         return NULL;
     }
     return m;
+}
+
+/* One common option (or a scene path) at argv[i]: arguments taken, 0 if not common, -1 malformed. */
+static int common_arg(BenchCommon *c, const char *a, const char *v)
+{
+    if (a[0] != '-') {
+        if (c->num_scenes == BENCH_MAX_SCENES) return -1;
+        c->scenes[c->num_scenes++] = a;
+        return 1;
+    }
+    bool ok;
+    if (strcmp(a, "--threads") == 0) ok = bench_parse_int(v, 1, 256, &c->threads);
+    else if (strcmp(a, "--repeat") == 0) ok = bench_parse_int(v, 1, 1000, &c->repeat);
+    else if (strcmp(a, "-o") == 0) ok = (c->dir = v) != NULL;
+    else return 0;
+    return ok ? 2 : -1;
+}
+
+bool bench_parse(int argc, char **argv, int repeat, BenchCommon *c, BenchOptionFn own, void *options)
+{
+    *c = (BenchCommon){.threads = omp_get_max_threads(), .repeat = repeat, .dir = "reports/bench"};
+    for (int i = 1; i < argc;) {
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int n = common_arg(c, argv[i], v);
+        if (n == 0 && own) n = own(options, argv[i], v);
+        if (n <= 0) return false;
+        i += n;
+    }
+    return true;
+}
+
+int bench_usage(const char *text)
+{
+    fprintf(stderr, "usage: %s\n", text);
+    return 2;
+}
+
+int bench_fail(const char *program, const Error *err)
+{
+    fprintf(stderr, "%s: %s\n", program, err->msg);
+    return 1;
 }

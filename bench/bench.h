@@ -28,6 +28,26 @@ bool bench_csv_reset(const char *path, const char *header, Error *err);
 void bench_csv_field(char *out, size_t n, const char *s);
 /* An integer argument in [lo, hi]; false when missing or malformed. */
 bool bench_parse_int(const char *s, int lo, int hi, int *out);
+/* The options most bench programs take: scene paths, --threads N,
+ * --repeat R and -o DIR (the folder of the CSVs). */
+#define BENCH_MAX_SCENES 8
+typedef struct BenchCommon {
+    const char *scenes[BENCH_MAX_SCENES];
+    int num_scenes, threads, repeat;
+    const char *dir;
+} BenchCommon;
+/* A program's own option `arg` with the argument after it (`value`, NULL
+ * at the end): returns how many of the two it took (1 or 2), 0 when it is
+ * unknown or malformed. */
+typedef int (*BenchOptionFn)(void *options, const char *arg, const char *value);
+/* Parse argv: the common options into *c (defaults: every core, `repeat`
+ * rounds, reports/bench), the rest through `own`; false on a bad argument. */
+bool bench_parse(int argc, char **argv, int repeat, BenchCommon *c, BenchOptionFn own, void *options);
+/* Print "usage: TEXT" and return the usage exit status, 2. */
+int bench_usage(const char *text);
+/* Print "PROGRAM: error" and return the runtime-error exit status, 1. */
+int bench_fail(const char *program, const Error *err);
+
 /* Median of n values (n >= 1; sorts a copy). */
 double bench_median(const double *v, int n);
 

@@ -44,10 +44,9 @@
     BENCH_TAIL_HEADER "\n"
 
 typedef struct Options {
-    const char *scenes[MAX_ITEMS];
-    int num_scenes, res[MAX_ITEMS], num_res, K[MAX_ITEMS], num_K;
-    int pcf_map, width, height, threads, repeat;
-    const char *dir;
+    BenchCommon c;
+    int res[MAX_ITEMS], num_res, K[MAX_ITEMS], num_K;
+    int pcf_map, width, height;
 } Options;
 
 /* The scene's casters: as the rasterizer reads them, and in GL buffers. */
@@ -66,29 +65,20 @@ static bool add_item(int *list, int *n, const char *v, int lo, int hi)
     return *n < MAX_ITEMS && bench_parse_int(v, lo, hi, &list[(*n)++]);
 }
 
+static int own_option(void *options, const char *a, const char *v)
+{
+    Options *o = options;
+    bool ok = false;
+    if (strcmp(a, "--res") == 0) ok = add_item(o->res, &o->num_res, v, 16, 8192);
+    else if (strcmp(a, "--pcf") == 0) ok = add_item(o->K, &o->num_K, v, 1, 63);
+    else if (strcmp(a, "--pcf-map") == 0) ok = bench_parse_int(v, 16, 8192, &o->pcf_map);
+    return ok ? 2 : 0;
+}
+
 static bool parse_options(int argc, char **argv, Options *o)
 {
-    *o = (Options){.pcf_map = 2048, .width = 1920, .height = 1080, .threads = omp_get_max_threads(), .repeat = 5,
-                   .dir = "reports/bench"};
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        bool ok;
-        if (a[0] != '-') {
-            if (o->num_scenes == MAX_ITEMS) return false;
-            o->scenes[o->num_scenes++] = a;
-            continue;
-        }
-        if (strcmp(a, "--res") == 0) ok = add_item(o->res, &o->num_res, v, 16, 8192);
-        else if (strcmp(a, "--pcf") == 0) ok = add_item(o->K, &o->num_K, v, 1, 63);
-        else if (strcmp(a, "--pcf-map") == 0) ok = bench_parse_int(v, 16, 8192, &o->pcf_map);
-        else if (strcmp(a, "--threads") == 0) ok = bench_parse_int(v, 1, 256, &o->threads);
-        else if (strcmp(a, "--repeat") == 0) ok = bench_parse_int(v, 1, 1000, &o->repeat);
-        else if (strcmp(a, "-o") == 0) ok = (o->dir = v) != NULL;
-        else return false;
-        if (!ok) return false;
-        i++;
-    }
-    return o->num_scenes > 0;
+    *o = (Options){.pcf_map = 2048, .width = 1920, .height = 1080};
+    return bench_parse(argc, argv, 5, &o->c, own_option, o) && o->c.num_scenes > 0;
 }
 
 /* ---- the casters in both forms --------------------------------------------- */
@@ -219,14 +209,14 @@ static bool depth_round(DepthRun *r, double *gl_s, double *ours_s, Error *err)
 
 static bool depth_measure(DepthRun *r, const Options *o, double med[3], Error *err)
 {
-    double *t = malloc(sizeof *t * 3 * (size_t)o->repeat), gl_s, ours_s;
+    double *t = malloc(sizeof *t * 3 * (size_t)o->c.repeat), gl_s, ours_s;
     if (!t) return error_set(err, "out of memory");
     bool ok = depth_round(r, &gl_s, &ours_s, err); /* warm-up */
-    for (int i = 0; ok && i < o->repeat; i++) {
-        ok = depth_round(r, &t[i], &t[o->repeat + i], err);
-        t[2 * o->repeat + i] = t[i] / t[o->repeat + i];
+    for (int i = 0; ok && i < o->c.repeat; i++) {
+        ok = depth_round(r, &t[i], &t[o->c.repeat + i], err);
+        t[2 * o->c.repeat + i] = t[i] / t[o->c.repeat + i];
     }
-    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->repeat, o->repeat);
+    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->c.repeat, o->c.repeat);
     free(t);
     return ok;
 }
@@ -235,14 +225,14 @@ static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c,
                             const DepthAgreement *a, const char *renderer, Error *err)
 {
     char row[2048], tail[512], name[160], rend[300];
-    bench_tail(tail, sizeof tail, o->threads);
+    bench_tail(tail, sizeof tail, o->c.threads);
     bench_csv_field(name, sizeof name, sc->name);
     bench_csv_field(rend, sizeof rend, renderer);
     snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%ld,%ld,%ld,%.3g,%s,%s,%s\n", name, c->triangles, res,
              med[0] * 1e3, med[1] * 1e3, med[2], a->covered, a->coverage_mismatch, a->depth_mismatch, a->max_diff,
              depth_agrees(a) ? "yes" : "no", rend, tail);
     char path[4096];
-    snprintf(path, sizeof path, "%s/llvmpipe_depth.csv", o->dir);
+    snprintf(path, sizeof path, "%s/llvmpipe_depth.csv", o->c.dir);
     printf("  depth %5d^2: llvmpipe %8.2f ms, shadowlab %8.2f ms, speed-up %.2fx; coverage off %ld, depth off %ld of "
            "%ld (max %.2g)%s\n",
            res, med[0] * 1e3, med[1] * 1e3, med[2], a->coverage_mismatch, a->depth_mismatch, a->covered, a->max_diff,
@@ -470,7 +460,7 @@ static bool write_pcf_row(const Options *o, const Scene *sc, int K, const double
                           const char *renderer, Error *err)
 {
     char row[2048], tail[512], name[160], rend[300], path[4096];
-    bench_tail(tail, sizeof tail, o->threads);
+    bench_tail(tail, sizeof tail, o->c.threads);
     bench_csv_field(name, sizeof name, sc->name);
     bench_csv_field(rend, sizeof rend, renderer);
     snprintf(row, sizeof row, "%s,%d,%d,%d,%d,%ld,%.3f,%.3f,%.3f,%.3g,%ld,%s,%s,%s\n", name, sc->camera.width,
@@ -479,20 +469,20 @@ static bool write_pcf_row(const Options *o, const Scene *sc, int K, const double
     printf("  pcf K=%2d at %dx%d: llvmpipe %8.2f ms, shadowlab %8.2f ms, speed-up %.2fx; MAE %.2g, %ld of %ld off%s\n",
            K, sc->camera.width, sc->camera.height, med[0] * 1e3, med[1] * 1e3, med[2], a->mae, a->off, a->candidates,
            pcf_agrees(a) ? "" : "  MISMATCH");
-    snprintf(path, sizeof path, "%s/llvmpipe_pcf.csv", o->dir);
+    snprintf(path, sizeof path, "%s/llvmpipe_pcf.csv", o->c.dir);
     return bench_csv_append(path, PCF_HEADER, row, err);
 }
 
 static bool pcf_measure(PcfRun *r, const Options *o, double med[3], Error *err)
 {
-    double *t = malloc(sizeof *t * 3 * (size_t)o->repeat), gl_s, ours_s;
+    double *t = malloc(sizeof *t * 3 * (size_t)o->c.repeat), gl_s, ours_s;
     if (!t) return error_set(err, "out of memory");
     bool ok = pcf_round(r, &gl_s, &ours_s, err); /* warm-up: builds the map, JITs the shader */
-    for (int i = 0; ok && i < o->repeat; i++) {
-        ok = pcf_round(r, &t[i], &t[o->repeat + i], err);
-        t[2 * o->repeat + i] = t[i] / t[o->repeat + i];
+    for (int i = 0; ok && i < o->c.repeat; i++) {
+        ok = pcf_round(r, &t[i], &t[o->c.repeat + i], err);
+        t[2 * o->c.repeat + i] = t[i] / t[o->c.repeat + i];
     }
-    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->repeat, o->repeat);
+    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->c.repeat, o->c.repeat);
     free(t);
     return ok;
 }
@@ -546,7 +536,7 @@ static bool bench_scene(const char *path, const GlContext *gl, const Options *o,
     Casters c;
     bool ok = casters_init(&c, lab_scene(lab), err);
     if (ok) printf("%s: %ld caster triangles, %d threads (LP_NUM_THREADS=%d)\n", lab_scene(lab)->name, c.triangles,
-                   o->threads, o->threads);
+                   o->c.threads, o->c.threads);
     for (int i = 0; ok && i < o->num_res; i++) ok = bench_depth(lab, &c, gl, o, o->res[i], err);
     if (ok && o->num_K > 0) ok = bench_pcf(lab, gl, o, err);
     casters_free(&c);
@@ -557,25 +547,18 @@ static bool bench_scene(const char *path, const GlContext *gl, const Options *o,
 int main(int argc, char **argv)
 {
     Options o;
-    if (!parse_options(argc, argv, &o)) {
-        fprintf(stderr, "usage: llvmpipe [--res R]... [--pcf K]... [--pcf-map R] [--threads N] [--repeat R] "
-                        "[-o DIR] SCENE...\n");
-        return 2;
-    }
+    if (!parse_options(argc, argv, &o))
+        return bench_usage("llvmpipe [--res R]... [--pcf K]... [--pcf-map R] [--threads N] [--repeat R] [-o DIR] SCENE...");
     char n[16];
-    snprintf(n, sizeof n, "%d", o.threads);
+    snprintf(n, sizeof n, "%d", o.c.threads);
     setenv("LP_NUM_THREADS", n, 1); /* read by llvmpipe when the context is created */
-    omp_set_num_threads(o.threads);
-    rt_set_threads(o.threads);
+    omp_set_num_threads(o.c.threads);
+    rt_set_threads(o.c.threads);
     Error err;
     GlContext *gl = gl_context_open(&err);
     bool ok = gl != NULL;
     if (ok) printf("llvmpipe bench: %s\n", gl_context_renderer(gl));
-    for (int i = 0; ok && i < o.num_scenes; i++) ok = bench_scene(o.scenes[i], gl, &o, &err);
+    for (int i = 0; ok && i < o.c.num_scenes; i++) ok = bench_scene(o.c.scenes[i], gl, &o, &err);
     gl_context_close(gl);
-    if (!ok) {
-        fprintf(stderr, "llvmpipe: %s\n", err.msg);
-        return 1;
-    }
-    return 0;
+    return ok ? 0 : bench_fail("llvmpipe", &err);
 }

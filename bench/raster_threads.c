@@ -20,10 +20,9 @@
 #define HEADER "scene,triangles,res,ms_1,ms_n,speedup,texels_written," BENCH_TAIL_HEADER "\n"
 
 typedef struct Options {
-    const char *scenes[MAX_ITEMS];
-    int num_scenes, res[MAX_ITEMS], num_res, threads, repeat;
+    BenchCommon c;
+    int res[MAX_ITEMS], num_res;
     bool profile;
-    const char *dir;
 } Options;
 
 typedef struct Job {
@@ -36,27 +35,18 @@ typedef struct Job {
     RasterStats stats;
 } Job;
 
+static int own_option(void *options, const char *a, const char *v)
+{
+    Options *o = options;
+    if (strcmp(a, "--profile") == 0) return o->profile = true;
+    bool ok = strcmp(a, "--res") == 0 && o->num_res < MAX_ITEMS && bench_parse_int(v, 16, 16384, &o->res[o->num_res++]);
+    return ok ? 2 : 0;
+}
+
 static bool parse_options(int argc, char **argv, Options *o)
 {
-    *o = (Options){.threads = omp_get_max_threads(), .repeat = 7, .dir = "reports/bench"};
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        bool ok;
-        if (a[0] != '-') {
-            if (o->num_scenes == MAX_ITEMS) return false;
-            o->scenes[o->num_scenes++] = a;
-            continue;
-        }
-        if (strcmp(a, "--profile") == 0) { o->profile = true; continue; }
-        if (strcmp(a, "--res") == 0) ok = o->num_res < MAX_ITEMS && bench_parse_int(v, 16, 16384, &o->res[o->num_res++]);
-        else if (strcmp(a, "--threads") == 0) ok = bench_parse_int(v, 1, 256, &o->threads);
-        else if (strcmp(a, "--repeat") == 0) ok = bench_parse_int(v, 1, 1000, &o->repeat);
-        else if (strcmp(a, "-o") == 0) ok = (o->dir = v) != NULL;
-        else return false;
-        if (!ok) return false;
-        i++;
-    }
-    return o->num_scenes > 0 && o->num_res > 0;
+    *o = (Options){.profile = false};
+    return bench_parse(argc, argv, 7, &o->c, own_option, o) && o->c.num_scenes > 0 && o->num_res > 0;
 }
 
 static bool timed_render(Job *j, int threads, double *seconds, Error *err)
@@ -71,14 +61,14 @@ static bool timed_render(Job *j, int threads, double *seconds, Error *err)
 /* Rounds of (1 thread, N threads); med = {t1, tN, t1/tN}. */
 static bool measure(Job *j, const Options *o, double med[3], Error *err)
 {
-    double *t = malloc(sizeof *t * 3 * (size_t)o->repeat), w;
+    double *t = malloc(sizeof *t * 3 * (size_t)o->c.repeat), w;
     if (!t) return error_set(err, "out of memory");
-    bool ok = timed_render(j, 1, &w, err) && timed_render(j, o->threads, &w, err);
-    for (int i = 0; ok && i < o->repeat; i++) {
-        ok = timed_render(j, 1, &t[i], err) && timed_render(j, o->threads, &t[o->repeat + i], err);
-        t[2 * o->repeat + i] = t[i] / t[o->repeat + i];
+    bool ok = timed_render(j, 1, &w, err) && timed_render(j, o->c.threads, &w, err);
+    for (int i = 0; ok && i < o->c.repeat; i++) {
+        ok = timed_render(j, 1, &t[i], err) && timed_render(j, o->c.threads, &t[o->c.repeat + i], err);
+        t[2 * o->c.repeat + i] = t[i] / t[o->c.repeat + i];
     }
-    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->repeat, o->repeat);
+    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->c.repeat, o->c.repeat);
     free(t);
     return ok;
 }
@@ -86,9 +76,9 @@ static bool measure(Job *j, const Options *o, double med[3], Error *err)
 static bool profile(Job *j, const Options *o, Error *err)
 {
     double s = 0.0;
-    for (int i = 0; i < o->repeat; i++)
-        if (!timed_render(j, o->threads, &s, err)) return false;
-    printf("  %d^2, %d threads: last render %.2f ms, %ld texels written\n", j->db.width, o->threads, s * 1e3,
+    for (int i = 0; i < o->c.repeat; i++)
+        if (!timed_render(j, o->c.threads, &s, err)) return false;
+    printf("  %d^2, %d threads: last render %.2f ms, %ld texels written\n", j->db.width, o->c.threads, s * 1e3,
            j->stats.texels_written);
     return true;
 }
@@ -96,13 +86,13 @@ static bool profile(Job *j, const Options *o, Error *err)
 static bool write_row(const Options *o, const Scene *sc, const Job *j, const double med[3], Error *err)
 {
     char row[1024], tail[512], name[160], path[4096];
-    bench_tail(tail, sizeof tail, o->threads);
+    bench_tail(tail, sizeof tail, o->c.threads);
     bench_csv_field(name, sizeof name, sc->name);
     snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%ld,%s\n", name, j->triangles, j->db.width, med[0] * 1e3,
              med[1] * 1e3, med[2], j->stats.texels_written, tail);
-    printf("  %5d^2: 1 thread %8.2f ms, %d threads %8.2f ms, speed-up %.2f\n", j->db.width, med[0] * 1e3, o->threads,
+    printf("  %5d^2: 1 thread %8.2f ms, %d threads %8.2f ms, speed-up %.2f\n", j->db.width, med[0] * 1e3, o->c.threads,
            med[1] * 1e3, med[2]);
-    snprintf(path, sizeof path, "%s/raster_threads.csv", o->dir);
+    snprintf(path, sizeof path, "%s/raster_threads.csv", o->c.dir);
     return bench_csv_append(path, HEADER, row, err);
 }
 
@@ -134,15 +124,10 @@ static bool bench_scene(const char *path, const Options *o, Error *err)
 int main(int argc, char **argv)
 {
     Options o;
-    if (!parse_options(argc, argv, &o)) {
-        fprintf(stderr, "usage: raster_threads [--res R]... [--threads N] [--repeat R] [--profile] [-o DIR] SCENE...\n");
-        return 2;
-    }
+    if (!parse_options(argc, argv, &o))
+        return bench_usage("raster_threads [--res R]... [--threads N] [--repeat R] [--profile] [-o DIR] SCENE...");
     Error err;
-    for (int i = 0; i < o.num_scenes; i++)
-        if (!bench_scene(o.scenes[i], &o, &err)) {
-            fprintf(stderr, "raster_threads: %s\n", err.msg);
-            return 1;
-        }
+    for (int i = 0; i < o.c.num_scenes; i++)
+        if (!bench_scene(o.c.scenes[i], &o, &err)) return bench_fail("raster_threads", &err);
     return 0;
 }

@@ -3,8 +3,8 @@
  * no edit here:
  *   growth: frame time (its resources' build times + set-up + the median
  *     evaluation, lab.h) and evaluation time against its main parameter
- *     (the first int or float parameter after the shared map block, or the
- *     first of a technique without one), against map_size where it has one,
+ *     (main_param: its first own int, else its first own parameter if a
+ *     float), against map_size where it has one,
  *     against triangle count (the scene's objects[2].segments) and against
  *     image size (camera.width x camera.height at 4:3);
  *   constant: techniques with a summed-area-table prefilter (a `prefilter`
@@ -34,9 +34,10 @@
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup,scene,width,height," BENCH_TAIL_HEADER "\n"
 
 typedef struct Options {
-    const char *scene, *only, *dir;
+    BenchCommon c;
+    const char *scene, *only;
     const char *techs[MAX_ITEMS];
-    int num_techs, threads, repeat;
+    int num_techs;
     bool quick;
 } Options;
 
@@ -46,24 +47,22 @@ typedef struct Point {
     int built;
 } Point;
 
+static int own_option(void *options, const char *a, const char *v)
+{
+    Options *o = options;
+    if (strcmp(a, "--quick") == 0) return o->quick = true;
+    if (!v) return 0;
+    if (strcmp(a, "--only") == 0) o->only = v;
+    else if (strcmp(a, "-t") == 0 && o->num_techs < MAX_ITEMS) o->techs[o->num_techs++] = v;
+    else return 0;
+    return 2;
+}
+
 static bool parse_options(int argc, char **argv, Options *o)
 {
-    *o = (Options){.scene = "scenes/sphere-on-plane.lua", .dir = "reports/bench", .threads = omp_get_max_threads(),
-                   .repeat = 3};
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        bool ok;
-        if (a[0] != '-') { o->scene = a; continue; }
-        if (strcmp(a, "--quick") == 0) { o->quick = true; continue; }
-        if (strcmp(a, "--only") == 0) ok = (o->only = v) != NULL;
-        else if (strcmp(a, "-t") == 0) ok = o->num_techs < MAX_ITEMS && (o->techs[o->num_techs++] = v) != NULL;
-        else if (strcmp(a, "--threads") == 0) ok = bench_parse_int(v, 1, 256, &o->threads);
-        else if (strcmp(a, "--repeat") == 0) ok = bench_parse_int(v, 1, 1000, &o->repeat);
-        else if (strcmp(a, "-o") == 0) ok = (o->dir = v) != NULL;
-        else return false;
-        if (!ok) return false;
-        i++;
-    }
+    *o = (Options){.quick = false};
+    if (!bench_parse(argc, argv, 3, &o->c, own_option, o) || o->c.num_scenes > 1) return false;
+    o->scene = o->c.num_scenes ? o->c.scenes[0] : "scenes/sphere-on-plane.lua";
     return true;
 }
 
@@ -79,7 +78,7 @@ static bool part(const Options *o, const char *name) { return !o->only || strcmp
 static bool append(const Options *o, const char *file, const char *header, const char *row, Error *err)
 {
     char path[4096];
-    snprintf(path, sizeof path, "%s/%s", o->dir, file);
+    snprintf(path, sizeof path, "%s/%s", o->c.dir, file);
     return bench_csv_append(path, header, row, err);
 }
 
@@ -90,7 +89,7 @@ static Lab *open_lab(const Options *o, const char *const *overrides, int n, Erro
     return lab_open(o->scene, overrides, n, err);
 }
 
-/* One warm-up then o->repeat timed evaluations (lab.h's timing). */
+/* One warm-up then o->c.repeat timed evaluations (lab.h's timing). */
 static bool measure(Lab *lab, const Technique *t, const double *params, int repeat, Point *p, Error *err)
 {
     RenderRequest req = {.tech = t, .params = params, .light_index = 0, .repeat = repeat};
@@ -105,13 +104,15 @@ static bool measure(Lab *lab, const Technique *t, const double *params, int repe
 
 /* ---- growth ---------------------------------------------------------------- */
 
-/* The main knob: the first int or float parameter after the shared map block. */
+/* The main knob among the technique's own parameters (after the shared map
+ * block): the first int (a kernel, a tap count, a level), else the first
+ * parameter when it is a float (a scale); none when an enum leads. */
 static int main_param(const Technique *t)
 {
     int first = smap_has_map_params(t) ? SMAP_NUM_PARAMS : 0;
     for (int i = first; i < t->num_params; i++)
-        if (t->params[i].type == PARAM_INT || t->params[i].type == PARAM_FLOAT) return i;
-    return -1;
+        if (t->params[i].type == PARAM_INT) return i;
+    return first < t->num_params && t->params[first].type == PARAM_FLOAT ? first : -1;
 }
 
 /* Values of a parameter: its default times 1/4 ... 8, clamped to its range,
@@ -137,7 +138,7 @@ static bool growth_row(const Options *o, const Technique *t, const char *axis, d
                        const Scene *sc, Error *err)
 {
     char row[1024], tail[512];
-    bench_tail(tail, sizeof tail, o->threads);
+    bench_tail(tail, sizeof tail, o->c.threads);
     snprintf(row, sizeof row, "%s,%s,%g,%.4f,%.4f,%.4f,%d,%s,%d,%d,%s\n", t->name, axis, value, p->frame_s * 1e3,
              p->eval_s * 1e3, p->build_s * 1e3, p->built, sc->name, sc->camera.width, sc->camera.height, tail);
     printf("  %-18s %-16s %10g: frame %9.3f ms, eval %9.3f ms, build %9.3f ms\n", t->name, axis, value,
@@ -154,7 +155,7 @@ static bool growth_param(const Options *o, Lab *lab, const Technique *t, int ind
     for (int i = 0; i < n; i++) {
         params[index] = values[i];
         Point p;
-        if (!measure(lab, t, params, o->repeat, &p, err) ||
+        if (!measure(lab, t, params, o->c.repeat, &p, err) ||
             !growth_row(o, t, t->params[index].name, values[i], &p, lab_scene(lab), err))
             return false;
     }
@@ -174,7 +175,7 @@ static bool growth_scene(const Options *o, const Technique *t, const char *axis,
         const char *ov[] = {a, b};
         Lab *lab = open_lab(o, ov, strcmp(axis, "image_width") == 0 ? 2 : 1, err);
         Point p;
-        bool ok = lab && measure(lab, t, params, o->repeat, &p, err) &&
+        bool ok = lab && measure(lab, t, params, o->c.repeat, &p, err) &&
                   growth_row(o, t, axis, strcmp(axis, "triangles") == 0 ? lab_scene(lab)->num_triangles : values[i],
                              &p, lab_scene(lab), err);
         lab_close(lab);
@@ -231,14 +232,14 @@ static bool constant_time(const Options *o, const Technique *t, Error *err)
     const ParamDesc *K = &t->params[kp];
     Point lo, hi;
     params[kp] = K->min;
-    bool ok = measure(lab, t, params, o->repeat, &lo, err);
+    bool ok = measure(lab, t, params, o->c.repeat, &lo, err);
     params[kp] = K->max;
-    ok = ok && measure(lab, t, params, o->repeat, &hi, err);
+    ok = ok && measure(lab, t, params, o->c.repeat, &hi, err);
     lab_close(lab);
     if (!ok) return false;
     double ratio = hi.frame_s / lo.frame_s;
     char row[1024], tail[512];
-    bench_tail(tail, sizeof tail, o->threads);
+    bench_tail(tail, sizeof tail, o->c.threads);
     snprintf(row, sizeof row, "%s,sat,%g,%g,%.4f,%.4f,%.3f,%.1f,%s,%s\n", t->name, K->min, K->max, lo.frame_s * 1e3,
              hi.frame_s * 1e3, ratio, CONSTANT_BOUND, ratio <= CONSTANT_BOUND ? "yes" : "no", tail);
     printf("  %-8s prefilter=sat: K=%g %.3f ms, K=%g %.3f ms, ratio %.2f (bound %.1f)%s\n", t->name, K->min,
@@ -280,25 +281,25 @@ static bool scaled_once(const Scaling *s, int threads, double *seconds, Error *e
 
 static bool scaling(const Options *o, Scaling *s, Error *err)
 {
-    double *t = malloc(sizeof *t * 3 * (size_t)o->repeat), w;
+    double *t = malloc(sizeof *t * 3 * (size_t)o->c.repeat), w;
     if (!t) return error_set(err, "out of memory");
-    bool ok = scaled_once(s, 1, &w, err) && scaled_once(s, o->threads, &w, err);
-    for (int i = 0; ok && i < o->repeat; i++) {
-        ok = scaled_once(s, 1, &t[i], err) && scaled_once(s, o->threads, &t[o->repeat + i], err);
-        t[2 * o->repeat + i] = t[i] / t[o->repeat + i];
+    bool ok = scaled_once(s, 1, &w, err) && scaled_once(s, o->c.threads, &w, err);
+    for (int i = 0; ok && i < o->c.repeat; i++) {
+        ok = scaled_once(s, 1, &t[i], err) && scaled_once(s, o->c.threads, &t[o->c.repeat + i], err);
+        t[2 * o->c.repeat + i] = t[i] / t[o->c.repeat + i];
     }
-    omp_set_num_threads(o->threads);
+    omp_set_num_threads(o->c.threads);
     double med[3];
-    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->repeat, o->repeat);
+    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->c.repeat, o->c.repeat);
     free(t);
     if (!ok) return false;
     const Scene *sc = lab_scene(s->lab);
     const char *name = s->t ? s->t->name : "reference";
     char row[1024], tail[512];
-    bench_tail(tail, sizeof tail, o->threads);
+    bench_tail(tail, sizeof tail, o->c.threads);
     snprintf(row, sizeof row, "%s,%.4f,%.4f,%.3f,%s,%d,%d,%s\n", name, med[0] * 1e3, med[1] * 1e3, med[2], sc->name,
              sc->camera.width, sc->camera.height, tail);
-    printf("  %-18s 1 thread %9.3f ms, %d threads %9.3f ms, speed-up %.2f\n", name, med[0] * 1e3, o->threads,
+    printf("  %-18s 1 thread %9.3f ms, %d threads %9.3f ms, speed-up %.2f\n", name, med[0] * 1e3, o->c.threads,
            med[1] * 1e3, med[2]);
     return append(o, "threads_eval.csv", THREADS_HEADER, row, err);
 }
@@ -322,13 +323,11 @@ static bool threads_all(const Options *o, Error *err)
 int main(int argc, char **argv)
 {
     Options o;
-    if (!parse_options(argc, argv, &o)) {
-        fprintf(stderr, "usage: techniques [--only growth|constant|threads] [-t TECH]... [--threads N] "
-                        "[--repeat R] [--quick] [-o DIR] [SCENE]\n");
-        return 2;
-    }
-    omp_set_num_threads(o.threads);
-    rt_set_threads(o.threads);
+    if (!parse_options(argc, argv, &o))
+        return bench_usage("techniques [--only growth|constant|threads] [-t TECH]... [--threads N] [--repeat R] "
+                           "[--quick] [-o DIR] [SCENE]");
+    omp_set_num_threads(o.c.threads);
+    rt_set_threads(o.c.threads);
     Error err;
     bool ok = true;
     for (int i = 0; ok && i < tech_count(); i++) {
@@ -338,9 +337,5 @@ int main(int argc, char **argv)
         if (ok && part(&o, "constant")) ok = constant_time(&o, t, &err);
     }
     if (ok && part(&o, "threads")) ok = threads_all(&o, &err);
-    if (!ok) {
-        fprintf(stderr, "techniques: %s\n", err.msg);
-        return 1;
-    }
-    return 0;
+    return ok ? 0 : bench_fail("techniques", &err);
 }

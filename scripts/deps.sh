@@ -6,6 +6,8 @@ set -u
 PACKAGES="build-essential pkg-config liblua5.4-dev lua5.4 libembree-dev libopenexr-dev \
 libopenimageio-dev zlib1g-dev gnuplot-nox glmark2-data \
 chromium parallel clang libclang-rt-14-dev valgrind"
+# Other package sets (bench/deps.sh) pass their own list as arguments.
+[ $# -gt 0 ] && PACKAGES="$*"
 
 missing=""
 for p in $PACKAGES; do
