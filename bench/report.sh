@@ -65,7 +65,7 @@ plots() {
         done
         plot llvmpipe_depth "set title 'Depth-only shadow map: speed-up over llvmpipe (same threads)'
 set xlabel 'map size (texels per side)'; set ylabel 'llvmpipe time / shadowlab time'; set logscale x 2; set grid
-set yrange [0:*]
+set yrange [0:2.5<*]
 plot $(for s in $(column "$dir/llvmpipe_depth.csv" scene | sort -u); do printf "'%s' using 1:2 with linespoints title '%s', " "$dir/llvmpipe_$s.dat" "$s"; done) 2 with lines dashtype 2 title 'target 2x'"
     fi
     if [ -f "$dir/growth.csv" ]; then
@@ -104,7 +104,7 @@ plot "
     if [ -f "$dir/threads_eval.csv" ]; then
         column "$dir/threads_eval.csv" technique speedup > "$dir/threads_eval.dat"
         plot threads_eval "set title 'Speed-up from 1 thread to $(column "$dir/threads_eval.csv" threads | head -1) threads'
-set style fill solid 0.5; set boxwidth 0.7; set ylabel 'speed-up'; set yrange [0:*]; set grid y
+set style fill solid 0.5; set boxwidth 0.7; set ylabel 'speed-up'; set yrange [0:2.2<*]; set grid y
 set xtics rotate by -45
 plot '$dir/threads_eval.dat' using 0:2:xtic(1) with boxes notitle, 1.8 with lines dashtype 2 title 'target 1.8'"
     fi
