@@ -273,7 +273,7 @@ function Experiment:open_results(o, configs)
   local header = { shadowlab_results = 1, name = self.name, settings = settings,
                    fingerprint = sl.hash(json.encode({ name = self.name, settings = settings })),
                    shard = o.shard, configurations = #configs, columns = self:columns() }
-  return records.open(jsonl, csv, header), header
+  return records.open(jsonl, csv, header, function(row) return row.status == "ok" end), header
 end
 
 local function image_paths(config)
@@ -359,6 +359,9 @@ function Experiment:run(argv)
                    computed = 0, skipped = 0, failed = 0, dropped = writer.dropped }
   if writer.dropped > 0 and not o.quiet then
     io.stderr:write(string.format("%s: dropped a half-written last row\n", writer.path))
+  end
+  if writer.retried > 0 and not o.quiet then
+    io.stderr:write(string.format("%s: retrying %d configurations that failed before\n", writer.path, writer.retried))
   end
   local mine = {}
   for _, c in ipairs(configs) do

@@ -93,17 +93,20 @@ end
 -- The images of one scene variant: the reference first, then every
 -- configuration's visibility and signed error.
 local function image_grid(entry, doc, out)
-  local first = entry.rows[1]
-  if not first.images then return end
+  local first
+  for _, r in ipairs(entry.rows) do first = first or (r.images and r) end
+  if not first then return end
   out[#out + 1] = '<div class="grid">'
   out[#out + 1] = figure(first.images.reference, "reference (" .. esc(first.record.reference.samples) ..
                          " samples)", "ref")
   out[#out + 1] = figure(first.images.reference_shaded, "reference, shaded", "ref")
   for _, r in ipairs(entry.rows) do
-    local cap = esc(r.label) .. ": " .. esc(doc.err_label) .. " " .. num(doc.err(r), "%.4f")
-    out[#out + 1] = figure(r.images.visibility, cap)
-    out[#out + 1] = figure(r.images.error, esc(r.label) .. ": signed error, ±" ..
-                           num(r.record.metrics.error_png_scale, "%g") .. " (blue too dark, red leaking)")
+    if r.images then -- rows resumed from a run with --no-images have none
+      local cap = esc(r.label) .. ": " .. esc(doc.err_label) .. " " .. num(doc.err(r), "%.4f")
+      out[#out + 1] = figure(r.images.visibility, cap)
+      out[#out + 1] = figure(r.images.error, esc(r.label) .. ": signed error, ±" ..
+                             num(r.record.metrics.error_png_scale, "%g") .. " (blue too dark, red leaking)")
+    end
   end
   out[#out + 1] = "</div>"
 end

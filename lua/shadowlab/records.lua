@@ -162,10 +162,12 @@ end
 -- A new file starts with `header`. An existing one must carry the same
 -- header.fingerprint (the same experiment), else it is refused; its rows
 -- are kept (writer.rows, writer.done[key]) and a half-written last row is
--- dropped (writer.dropped = 1). CSV columns come from header.columns.
-function records.open(jsonl_path, csv_path, header)
+-- dropped (writer.dropped = 1); rows that keep(row) refuses are dropped too
+-- (writer.retried counts them: a sweep retries its failed configurations).
+-- CSV columns come from header.columns.
+function records.open(jsonl_path, csv_path, header, keep)
   local w = setmetatable({ path = jsonl_path, csv_path = csv_path, columns = header.columns,
-                           rows = {}, done = {}, dropped = 0 }, Writer)
+                           rows = {}, done = {}, dropped = 0, retried = 0 }, Writer)
   local old, rows, dropped = records.read(jsonl_path)
   if old then
     if old.fingerprint ~= header.fingerprint then
@@ -174,8 +176,11 @@ function records.open(jsonl_path, csv_path, header)
                           tostring(old.fingerprint), json.encode(old.settings or {}), header.name,
                           header.fingerprint, json.encode(header.settings)), 0)
     end
-    w.rows, w.dropped = rows, dropped
-    if dropped > 0 then sl.write_file(jsonl_path, file_text(old, rows)) end
+    w.dropped = dropped
+    for _, row in ipairs(rows) do
+      if not keep or keep(row) then w.rows[#w.rows + 1] = row else w.retried = w.retried + 1 end
+    end
+    if dropped + w.retried > 0 then sl.write_file(jsonl_path, file_text(old, w.rows)) end
   else
     sl.write_file(jsonl_path, file_text(header, {}))
     sl.fsync_dir(folder_of(jsonl_path))

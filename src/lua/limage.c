@@ -17,6 +17,7 @@ void sl_push_image_copy(lua_State *L, const Image *src)
     Error err;
     if (!image_init(img, src->width, src->height, src->channels, &err)) sl_raise(L, &err);
     memcpy(img->data, src->data, image_count(src) * sizeof(float));
+    lua_gc(L, LUA_GCSTEP, (int)(image_count(src) * sizeof(float) / 1024)); /* pixels the collector cannot see */
 }
 
 /* img:size() -> width, height, channels */

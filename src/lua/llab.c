@@ -4,6 +4,7 @@
  * (render, reference, compare) with the same options as a table; unknown
  * options and out-of-range values raise errors naming them. Closed by
  * lab:close(), a to-be-closed variable, or the garbage collector. */
+#include <math.h>
 #include <omp.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -145,26 +146,36 @@ static void check_option_names(lua_State *L, int idx, const char *method)
     }
 }
 
-static int opt_int(lua_State *L, int idx, const char *name, int def, int lo, int hi)
-{
-    lua_getfield(L, idx, name);
-    int isnum = 0;
-    lua_Integer v = lua_isnil(L, -1) ? def : lua_tointegerx(L, -1, &isnum);
-    if (!lua_isnil(L, -1) && !isnum) luaL_error(L, "option %s must be an integer in [%d, %d]", name, lo, hi);
-    if (v < lo || v > hi) luaL_error(L, "option %s = %d outside [%d, %d]", name, (int)v, lo, hi);
-    lua_pop(L, 1);
-    return (int)v;
-}
-
-static double opt_number(lua_State *L, int idx, const char *name, double def, double lo, double hi)
+/* A numeric option in [lo, hi] (integral when `integer`); raises naming it
+ * and its range. (lua_pushfstring has no %g: the message is formatted here.) */
+static double opt_value(lua_State *L, int idx, const char *name, double def, double lo, double hi, bool integer)
 {
     lua_getfield(L, idx, name);
     int isnum = 0;
     double v = lua_isnil(L, -1) ? def : lua_tonumberx(L, -1, &isnum);
-    if (!lua_isnil(L, -1) && !isnum) luaL_error(L, "option %s must be a number in [%g, %g]", name, lo, hi);
-    if (!(v >= lo && v <= hi)) luaL_error(L, "option %s = %g outside [%g, %g]", name, v, lo, hi);
+    bool present = !lua_isnil(L, -1);
+    char value[64];
+    if (present && !isnum) snprintf(value, sizeof value, "a %s", luaL_typename(L, -1));
+    else snprintf(value, sizeof value, "%g", v);
     lua_pop(L, 1);
+    if ((present && !isnum) || !(v >= lo && v <= hi) || (integer && v != floor(v))) {
+        char msg[256];
+        snprintf(msg, sizeof msg, integer ? "option %s = %s is invalid: expected an integer in [%.0f, %.0f]"
+                                          : "option %s = %s is invalid: expected a number in [%g, %g]",
+                 name, value, lo, hi);
+        luaL_error(L, "%s", msg);
+    }
     return v;
+}
+
+static double opt_number(lua_State *L, int idx, const char *name, double def, double lo, double hi)
+{
+    return opt_value(L, idx, name, def, lo, hi, false);
+}
+
+static int opt_int(lua_State *L, int idx, const char *name, int def, int lo, int hi)
+{
+    return (int)opt_value(L, idx, name, def, lo, hi, true);
 }
 
 static bool opt_bool(lua_State *L, int idx, const char *name, bool def)

@@ -56,6 +56,11 @@ void sl_push_run(lua_State *L, CompareResult *res, const RunReport *rep)
     if (res->ref && (!copy_image(&res->ref->value, &run->ref_value, &err) ||
                      !copy_image(&res->ref->std_error, &run->ref_stderr, &err)))
         sl_raise(L, &err);
+    /* Tell the collector about the images it cannot see, so a long sweep
+     * collects finished Runs before their pixels pile up. */
+    size_t pixels = image_count(&run->res.render.visibility) + image_count(&run->res.signed_error) +
+                    image_count(&run->ref_value) + image_count(&run->ref_stderr);
+    lua_gc(L, LUA_GCSTEP, (int)(pixels * sizeof(float) / 1024));
     size_t len;
     char *json = record_text(L, rep, &len);
     run->res.ref = NULL;

@@ -142,7 +142,7 @@ expect resume_refuses_another_experiment 1 "fingerprint" "--fresh" -- \
 # ---- the shipped experiments at tiny settings (the default runs are the README's)
 TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeats 1 --warmup 0 --no-images"
 expect error_vs_time_runs 0 "report:" -- "$SL" run experiments/error-vs-time.lua --factors 1 $TINY --out "$TMP/evt"
-expect error_vs_time_plot_shows_every_registered_technique 0 "registered techniques" -- \
+expect error_vs_time_plot_shows_every_registered_technique 0 "every registered technique" -- \
     "$SL" run tests/lua/every-technique.lua "$TMP/evt"
 expect lab_kernel_size_runs 0 "0 failed" "report:" -- \
     "$SL" run experiments/lab-kernel-size.lua --techniques pcf $TINY --out "$TMP/lks"

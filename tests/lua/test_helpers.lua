@@ -158,6 +158,20 @@ test("records_drop_a_half_written_last_row_and_keep_the_rest", function()
   assert(line_count(csv) == 4, "the CSV has a header and the three rows")
 end)
 
+test("records_drop_rows_to_retry_and_rewrite_the_file", function()
+  local path, csv = tmp .. "/retry.jsonl", tmp .. "/retry.csv"
+  local w = records.open(path, csv, header("f1"))
+  w:append{ index = 0, key = "a", status = "ok" }
+  w:append{ index = 1, key = "b", status = "error", error = "out of memory" }
+  w:close()
+  local ok_only = function(row) return row.status == "ok" end
+  w = records.open(path, csv, header("f1"), ok_only)
+  assert(w.retried == 1 and w.done.a and not w.done.b, "the failed row is to be retried")
+  w:close()
+  local _, rows = records.read(path)
+  assert(#rows == 1 and rows[1].key == "a", "and it is gone from the file")
+end)
+
 test("records_refuse_a_corrupt_middle_line_and_another_experiment", function()
   local path = tmp .. "/bad.jsonl"
   sl.write_file(path, json.encode(header("f1")) .. '\n{"key":"a"}\n{"key": oops}\n{"key":"b"}\n')
