@@ -203,17 +203,20 @@ end
 
 -- Open every variant's Lab and list the configurations in a fixed order
 -- (variants, then techniques, then points). A technique is left out of a
--- variant whose light it does not handle (the registry says which).
+-- variant whose light it does not handle (the registry says which); a
+-- configuration listed twice (same key: a point equal to the defaults, a
+-- repeated value) runs once.
 function Experiment:configurations()
-  local configs = {}
+  local configs, seen = {}, {}
   for vi, v in ipairs(self.variants) do
     v.lab = v.lab or sl.open(v.file, v.overrides)
     v.info = v.lab:info()
     local light = v.info.lights[self.light]
     if not light then error(string.format("%s has no light %d", v.file, self.light), 0) end
     for _, e in ipairs(self.entries) do
-      if technique_handles(e.technique, light.type) then
-        local key = v.lab:key(e.technique.name, e.params, self.light)
+      local key = technique_handles(e.technique, light.type) and v.lab:key(e.technique.name, e.params, self.light)
+      if key and not seen[key] then
+        seen[key] = true
         configs[#configs + 1] = { index = #configs, variant = v, variant_index = vi, entry = e, key = key,
                                   label = point_label(e) }
       end

@@ -224,6 +224,15 @@ test("configuration_keys_are_stable_and_depend_on_the_scene_and_every_parameter"
   for _, lab in ipairs({ a, b, c }) do lab:close() end
 end)
 
+test("experiment_runs_a_configuration_listed_twice_once", function()
+  local e = experiment.new{ name = "twice", samples = 4, repeats = 1, warmup = 0, overrides = small }
+  e:scene("scenes/sphere-on-plane.lua")
+  e:add("hard")
+  e:add("hard", { { offset_scale = 1 }, { offset_scale = 2 }, { offset_scale = 2 } })
+  local r = e:run({ "--out", tmp .. "/twice", "--no-images", "--quiet" })
+  assert(#r.rows == 2 and r.computed == 2, "rows " .. #r.rows)
+end)
+
 test("autotune_returns_the_best_feasible_point_it_evaluated", function()
   local lab = sl.open("scenes/sphere-on-plane.lua", small)
   local r = autotune.run{ lab = lab, technique = "hard", budget_s = 1e3, evaluations = 6, initial = 3, samples = 8,
