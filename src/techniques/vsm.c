@@ -55,7 +55,8 @@ static const ParamDesc evsm_params[] = {
      warp_names},
     {"exponent_pos", PARAM_FLOAT, 40, 0.1, 350, "1 / normalised depth",
      "c+ of the warp exp(c+ u); stored scaled by exp(-c+), so any value is finite; fp32 moments underflow where "
-     "c+ (1 - u) > 44 (the catalogue's fp32 limit is c < 44), double ones up to 350",
+     "c+ (1 - u) > 44 (the catalogue's fp32 limit is c < 44), double ones up to 350; a SAT's rounding swamps "
+     "moments below ~1e-12 of the face's, so prefilter=box",
      NULL},
     {"exponent_neg", PARAM_FLOAT, 10, 0.1, 350, "1 / normalised depth", "c- of the negative warp -exp(-c- u)",
      NULL},
