@@ -669,3 +669,124 @@ void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int 
     *zmin = lo;
     *zmax = hi;
 }
+
+/* ---- N-buffer level ---- */
+
+static void buffer_destroy(void *r)
+{
+    MinMaxBuffer *b = r;
+    free(b->minmax);
+    free(b);
+}
+
+static size_t buffer_bytes(const void *r)
+{
+    const MinMaxBuffer *b = r;
+    return sizeof *b + (size_t)b->num_faces * b->res * b->res * 2 * sizeof(float);
+}
+
+static const ResourceKind kind_buffer = {"minmax_buffer", buffer_bytes, buffer_destroy};
+
+typedef struct BufferArgs { const ShadowMap *map; int level; uint64_t key; } BufferArgs;
+
+int minmax_buffer_level(int K)
+{
+    int level = 0;
+    while ((2 << level) <= (K + 1) / 2) level++;
+    return level;
+}
+
+/* Level k from level k - 1: the four blocks of half the size at offsets
+ * (0 or h, 0 or h), h = 2^(k-1), indices clamped to the face. */
+static void buffer_double(const float *in, float *out, int res, int faces, int half)
+{
+    int rows = faces * res;
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < rows; r++) {
+        int f = r / res, j = r % res;
+        for (int i = 0; i < res; i++) {
+            float lo = INFINITY, hi = -INFINITY;
+            for (int b = 0; b < 2; b++)
+                for (int a = 0; a < 2; a++) {
+                    const float *q = in + 2 * (((size_t)f * res + clampi(j + b * half, 0, res - 1)) * res +
+                                               clampi(i + a * half, 0, res - 1));
+                    lo = fminf(lo, q[0]);
+                    hi = fmaxf(hi, q[1]);
+                }
+            float *o = out + 2 * (((size_t)f * res + j) * res + i);
+            o[0] = lo;
+            o[1] = hi;
+        }
+    }
+}
+
+static void *build_buffer(const void *args, Error *err)
+{
+    const BufferArgs *a = args;
+    const ShadowMap *m = a->map;
+    size_t n = (size_t)m->num_faces * m->res * m->res;
+    MinMaxBuffer *b = calloc(1, sizeof *b);
+    float *other = a->level > 0 ? malloc(n * 2 * sizeof *other) : NULL;
+    if (b) b->minmax = malloc(n * 2 * sizeof *b->minmax);
+    if (!b || !b->minmax || (a->level > 0 && !other)) {
+        free(other);
+        if (b) buffer_destroy(b);
+        error_set(err, "out of memory for a %d^2 min-max N-buffer", m->res);
+        return NULL;
+    }
+    *b = (MinMaxBuffer){a->key, m->res, m->num_faces, a->level, b->minmax};
+    /* Level 0 goes where the last doubling will land, so the result ends in b->minmax. */
+    float *cur = a->level % 2 ? other : b->minmax, *next = a->level % 2 ? b->minmax : other;
+    for (size_t k = 0; k < n; k++) cur[2 * k] = cur[2 * k + 1] = m->depth[k];
+    for (int l = 1; l <= a->level; l++) {
+        buffer_double(cur, next, m->res, m->num_faces, 1 << (l - 1));
+        float *t = cur;
+        cur = next;
+        next = t;
+    }
+    free(other);
+    return b;
+}
+
+const MinMaxBuffer *res_minmax_buffer(ResourceManager *rm, const ShadowMap *map, int level, Error *err)
+{
+    Hasher h;
+    hash_init(&h);
+    hash_u64(&h, map->key);
+    hash_str(&h, "nbuffer");
+    hash_u64(&h, (uint64_t)level);
+    BufferArgs a = {map, level, hash_final(&h)};
+    char desc[160], mk[17];
+    hash_hex(map->key, mk);
+    snprintf(desc, sizeof desc, "min-max N-buffer level %d (%d^2 blocks) of map %s", level, 1 << level, mk);
+    return rm_acquire(rm, &kind_buffer, a.key, desc, build_buffer, &a, err);
+}
+
+/* Block starts covering [a, b] with blocks of `step`: a, a + step, ..., and
+ * b - step + 1 last (overlaps are harmless for min and max). */
+static int block_starts(int a, int b, int step, int *out, int max)
+{
+    int n = 0;
+    for (int x = a; n < max - 1 && x + step - 1 < b; x += step) out[n++] = x;
+    out[n++] = b - step + 1 > a ? b - step + 1 : a;
+    return n;
+}
+
+void minmax_buffer_query(const MinMaxBuffer *b, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax)
+{
+    i0 = clampi(i0, 0, b->res - 1);
+    i1 = clampi(i1, 0, b->res - 1);
+    j0 = clampi(j0, 0, b->res - 1);
+    j1 = clampi(j1, 0, b->res - 1);
+    int step = 1 << b->level, xs[PREFILTER_MAX_K + 2], ys[PREFILTER_MAX_K + 2];
+    int nx = block_starts(i0, i1, step, xs, PREFILTER_MAX_K + 2), ny = block_starts(j0, j1, step, ys, PREFILTER_MAX_K + 2);
+    float lo = INFINITY, hi = -INFINITY;
+    for (int y = 0; y < ny; y++)
+        for (int x = 0; x < nx; x++) {
+            const float *q = b->minmax + 2 * (((size_t)face * b->res + ys[y]) * b->res + xs[x]);
+            lo = fminf(lo, q[0]);
+            hi = fmaxf(hi, q[1]);
+        }
+    *zmin = lo;
+    *zmax = hi;
+}

@@ -3,8 +3,9 @@
  * (per-texel warps of the depth: powers, layers, exponentials, Fourier
  * bases, or a log-exponential channel for ESM), their prefiltered forms (a
  * separable K x K box blur, or a summed-area table that serves every K), and
- * a min-max mip pyramid of the depth (ESM's classifier, §4.2.4). So a sweep
- * over K builds one moment map and one SAT; a box blur is keyed by K.
+ * a min-max mip pyramid or one N-buffer level of the depth (ESM's
+ * classifiers, §4.2.4). So a sweep over K builds one moment map and one SAT;
+ * a box blur is keyed by K.
  *
  * Depth is normalised per face, u = (z - near) / (far - near) in [0, 1]
  * (linear maps; ndc maps store u = z_ndc), the course's convention for
@@ -127,5 +128,23 @@ const MinMaxPyramid *res_minmax_pyramid(ResourceManager *rm, const ShadowMap *ma
 /* Conservative bounds of the stored depth over texels [i0, i1] x [j0, j1]
  * (clamped to the face: the same texels as an edge-clamped window). */
 void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax);
+
+/* One level of an N-buffer (Decoret 2005; course ch.4 box "Fast-box Filter
+ * Approximations"): the min and max of the stored depth over the 2^level x
+ * 2^level texels starting at each texel (edge-clamped), at full resolution.
+ * A window's bounds are then exact from a few overlapping blocks, where the
+ * mip pyramid's aligned nodes cover up to four times the window. */
+typedef struct MinMaxBuffer {
+    uint64_t key;
+    int res, num_faces, level;
+    float *minmax;        /* pairs (min, max), [(face * res + j) * res + i] */
+} MinMaxBuffer;
+
+/* The level a K-wide window reads: blocks no wider than half the window. */
+int minmax_buffer_level(int K);
+const MinMaxBuffer *res_minmax_buffer(ResourceManager *rm, const ShadowMap *map, int level, Error *err);
+/* Exact bounds over texels [i0, i1] x [j0, j1], clamped to the face
+ * (conservative only for windows narrower than a block). */
+void minmax_buffer_query(const MinMaxBuffer *b, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax);
 
 #endif

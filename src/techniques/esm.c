@@ -5,12 +5,13 @@
  * SAT of e^(c u - max)), so no c overflows. Where the assumption z_q <= d
  * fails, a classifier sends the sample to PCF with clamped terms,
  * sum_q w min(1, exp(c (z_q - d_q))): the filtered value above 1 (fast,
- * approximate) or a min-max pyramid's window bounds (conservative). */
+ * approximate), or the window's depth bounds on both sides of the receiver,
+ * from a min-max pyramid (conservative) or exact from an N-buffer level. */
 #include <stdlib.h>
 #include "techniques/filtered.h"
 
-enum { CLASSIFY_NONE, CLASSIFY_VALUE, CLASSIFY_MINMAX };
-static const char *const classifier_names[] = {"none", "value", "minmax", NULL};
+enum { CLASSIFY_NONE, CLASSIFY_VALUE, CLASSIFY_MINMAX, CLASSIFY_NBUFFER };
+static const char *const classifier_names[] = {"none", "value", "minmax", "nbuffer", NULL};
 enum { OUTPUT_VISIBILITY, OUTPUT_FALLBACK };
 static const char *const output_names[] = {"visibility", "fallback", NULL};
 
@@ -24,9 +25,11 @@ static const ParamDesc esm_params[] = {
      "c of exp(c z) (course: 80); filtered in log space, so values past fp32's 88.7 and double's 709 stay "
      "finite; a SAT's window sums lose precision as c grows and fall back to PCF",
      NULL},
-    {"classifier", PARAM_ENUM, CLASSIFY_MINMAX, 0, 2, "",
+    {"classifier", PARAM_ENUM, CLASSIFY_NBUFFER, 0, 3, "",
      "where to fall back to PCF (course §4.2.4): none; value (the filtered value exceeds 1); minmax (the "
-     "window holds depths on both sides of the receiver, from a min-max pyramid: conservative)",
+     "window holds depths on both sides of the receiver, bounded by a min-max mip pyramid's aligned nodes: "
+     "conservative, up to 4x the window); nbuffer (the same test with the window's exact bounds, from one "
+     "N-buffer level)",
      classifier_names},
     {"output", PARAM_ENUM, OUTPUT_VISIBILITY, 0, 1, "",
      "visibility, or fallback: 1 where the sample was filtered by PCF, 0 elsewhere (the fallback share)",
@@ -35,11 +38,12 @@ static const ParamDesc esm_params[] = {
 FILTER_CHECK_TABLE(esm_params);
 
 static const char *const esm_resources[] = {"shadow_map", "view_samples", "moments", "box_blur", "sat",
-                                            "minmax_pyramid", NULL};
+                                            "minmax_pyramid", "minmax_buffer", NULL};
 
 typedef struct EsmState {
     FilteredMaps fm;
     const MinMaxPyramid *pyramid; /* minmax classifier only */
+    const MinMaxBuffer *nbuffer;  /* nbuffer classifier only */
     double c;
     int classifier, output;
 } EsmState;
@@ -55,6 +59,8 @@ static bool esm_prepare(const TechContext *ctx, void **state, Error *err)
     MomentSpec spec = {.warp = WARP_LOG_EXP, .order = 1, .c_pos = st->c};
     bool ok = filtered_acquire(ctx, spec, &st->fm, err);
     if (ok && st->classifier == CLASSIFY_MINMAX) ok = (st->pyramid = res_minmax_pyramid(ctx->rm, st->fm.map, err));
+    if (ok && st->classifier == CLASSIFY_NBUFFER)
+        ok = (st->nbuffer = res_minmax_buffer(ctx->rm, st->fm.map, minmax_buffer_level(st->fm.K), err));
     if (!ok) {
         free(st);
         return false;
@@ -85,6 +91,8 @@ static double esm_pcf(const EsmState *st, const FilteredSample *fs)
 
 typedef enum Verdict { VERDICT_LIT, VERDICT_ESM, VERDICT_PCF } Verdict;
 
+/* The bounds classifiers compare the window with the sample's own
+ * reference depth; per-texel receiver-plane depths apply in the fallback. */
 static Verdict classify(const EsmState *st, const FilteredSample *fs, double esm)
 {
     if (!fs->reliable) return VERDICT_PCF;
@@ -93,7 +101,8 @@ static Verdict classify(const EsmState *st, const FilteredSample *fs, double esm
     const PfFootprint *fp = &fs->fp;
     int last = fp->K - 1 + fp->bilinear;
     float zmin, zmax;
-    minmax_query(st->pyramid, fs->r.mc.face, fp->i0, fp->j0, fp->i0 + last, fp->j0 + last, &zmin, &zmax);
+    if (st->pyramid) minmax_query(st->pyramid, fs->r.mc.face, fp->i0, fp->j0, fp->i0 + last, fp->j0 + last, &zmin, &zmax);
+    else minmax_buffer_query(st->nbuffer, fs->r.mc.face, fp->i0, fp->j0, fp->i0 + last, fp->j0 + last, &zmin, &zmax);
     if (zmin >= fs->r.ref) return VERDICT_LIT;  /* nothing in front: every test passes */
     return zmax > fs->r.ref ? VERDICT_PCF : VERDICT_ESM;
 }

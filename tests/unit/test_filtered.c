@@ -255,10 +255,11 @@ TEST(test_esm_large_exponents_stay_finite_in_f32_and_f64)
     CHECK_MSG(isinf(naive_f32_sum(m, 80.0f)), "a naive f32 sum of exp(80 u) should overflow");
     static const char *const cases[] = {"prefilter=box precision=f64", "prefilter=box precision=f32",
                                         "prefilter=sat precision=f64", "prefilter=sat precision=f32"};
-    static const char *const classifiers[] = {"classifier=none", "classifier=value", "classifier=minmax"};
+    static const char *const classifiers[] = {"classifier=none", "classifier=value", "classifier=minmax",
+                                              "classifier=nbuffer"};
     for (int c = 0; c < 2; c++)
         for (int k = 0; k < 4; k++)
-            for (int q = 0; q < 3; q++) {
+            for (int q = 0; q < 4; q++) {
                 char p[256];
                 snprintf(p, sizeof p, "map_size=512 K=9 exponent=%d %s %s", c ? 200 : 80, cases[k], classifiers[q]);
                 RenderResult r;
@@ -267,7 +268,46 @@ TEST(test_esm_large_exponents_stay_finite_in_f32_and_f64)
                 CHECK_MSG(bad == 0, "esm %s: %ld samples NaN, Inf or outside [0, 1]", p, bad);
                 render_result_free(&r);
             }
-    printf("    naive f32 sum of exp(80 u): inf; esm c = 80, 200 x box/sat x f64/f32 x 3 classifiers: all finite\n");
+    printf("    naive f32 sum of exp(80 u): inf; esm c = 80, 200 x box/sat x f64/f32 x 4 classifiers: all finite\n");
+    lab_close(lab);
+}
+
+/* ---- ESM's classifiers: window bounds ---- */
+
+TEST(test_minmax_pyramid_bounds_and_nbuffer_equals_every_window)
+{
+    Error err;
+    Lab *lab = filtered_open("scenes/cones-and-hills.lua", 64, 48);
+    CHECK(lab);
+    ShadowMapSpec spec = shadowmap_spec_default();
+    spec.res = 200; /* not a power of two: partial nodes and clamped blocks */
+    const ShadowMap *m = res_shadow_map(lab_resources(lab), lab_scene(lab), 0, &spec, &err);
+    const MinMaxPyramid *pyr = m ? res_minmax_pyramid(lab_resources(lab), m, &err) : NULL;
+    CHECK(pyr);
+    long windows = 0, loose = 0;
+    uint32_t h = 12345u;
+    for (int K = 1; K <= PREFILTER_MAX_K; K += 6) {
+        const MinMaxBuffer *nb = res_minmax_buffer(lab_resources(lab), m, minmax_buffer_level(K), &err);
+        CHECK(nb);
+        for (int n = 0; n < 300; n++, windows++) {
+            h = h * 1664525u + 1013904223u;
+            int i0 = (int)(h >> 8) % (m->res + K) - K / 2, j0 = (int)((h >> 3) % (uint32_t)(m->res + K)) - K / 2;
+            float lo = INFINITY, hi = -INFINITY, plo, phi, blo, bhi;
+            for (int j = j0; j < j0 + K; j++)
+                for (int i = i0; i < i0 + K; i++) {
+                    lo = fminf(lo, shadowmap_texel(m, 0, i, j));
+                    hi = fmaxf(hi, shadowmap_texel(m, 0, i, j));
+                }
+            minmax_query(pyr, 0, i0, j0, i0 + K - 1, j0 + K - 1, &plo, &phi);
+            minmax_buffer_query(nb, 0, i0, j0, i0 + K - 1, j0 + K - 1, &blo, &bhi);
+            CHECK_MSG(plo <= lo && phi >= hi, "pyramid [%g, %g] misses [%g, %g]", plo, phi, lo, hi);
+            CHECK_MSG(blo == lo && bhi == hi, "K = %d at (%d, %d): n-buffer [%g, %g], window [%g, %g]", K, i0, j0, blo,
+                      bhi, lo, hi);
+            loose += plo < lo || phi > hi;
+        }
+    }
+    printf("    %ld windows, K = 1..61: n-buffer exact in all, pyramid conservative, looser in %ld\n", windows, loose);
+    CHECK(loose > 0);
     lab_close(lab);
 }
 
