@@ -20,10 +20,10 @@ SHADOWLAB_CACHE=$(mktemp -d) ./tests/cli/run.sh "$B/shadowlab" 2>&1 | tee -a "$l
 ./tests/lua/run.sh "$B/shadowlab" 2>&1 | tee -a "$log"
 # The stability suite: its harness self-tests ("harness:") and the engine's
 # extreme cases under ASan + UBSan ("sanitized:"), the registry's whole
-# matrix in quick mode ("stability:"); then the short fuzz run, the valgrind
-# runs and the kill test of atomic outputs.
+# matrix in quick mode, two one-thread runs at once ("stability:"); then the
+# short fuzz run, the valgrind runs and the kill test of atomic outputs.
 "./$B/test_stability_san" 2>&1 | tee -a "$log"
-"./$B/shadowlab" stability --quick 2>&1 | tee -a "$log"
+"./$B/shadowlab" stability --quick --jobs 2 --threads 1 2>&1 | tee -a "$log"
 ./tests/fuzz/run.sh "$B" 2>&1 | tee -a "$log"
 ./tests/valgrind/run.sh "$B/shadowlab" 2>&1 | tee -a "$log"
 ./tests/stability/atomic.sh "$B/shadowlab" 2>&1 | tee -a "$log"

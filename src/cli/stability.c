@@ -15,20 +15,25 @@ static const char *const stability_help =
     "usage: shadowlab stability [-t TECH] [-o DIR] [options]\n"
     "  every technique of the registry (or -t TECH) on every extreme case that applies to it:\n"
     "  output finite and in [0,1], documented limits, refusals of invalid input; each run in\n"
-    "  its own process with a time bound\n"
+    "  its own process with a time bound, forked from one that built what the runs on a case\n"
+    "  share (scene, BVH, view samples, reference)\n"
     "  -t, --technique NAME   only this technique (engine input cases are then skipped)\n"
-    "  -o, --out DIR          write DIR/stability.{json,csv,md} and DIR/scenes/<row>/scene.lua\n"
+    "  -o, --out DIR          write DIR/stability.{json,csv,md} and DIR/scenes/<case>-<light>/scene.lua\n"
+    "                         (parameter rows: DIR/scenes/params-<light>/scene.lua)\n"
     "  --case TEXT            only cases whose name contains TEXT\n"
-    "  --quick                reduced image sizes and reference samples (make test); every case runs\n"
+    "  --quick                make test's matrix: 40 x 30 views, 16 reference samples (none for heavy\n"
+    "                         cases), map sizes capped at 128 texels except in their own probes, one row\n"
+    "                         per parameter for all its probes; every case runs\n"
     "  --timeout S            per-run time bound in seconds (default 120)\n"
-    "  --threads N            threads per run (default: all cores)\n"
+    "  --threads N            threads per run (default: the cores divided among --jobs)\n"
+    "  --jobs N               runs at once (default 1)\n"
     "  --list                 list the cases and exit\n";
 
 typedef struct StabCli {
     const char *tech, *out, *only;
     bool quick, list, help;
     double timeout_s;
-    int threads;
+    int threads, jobs;
 } StabCli;
 
 static bool parse_number(const char *opt, const char *s, double lo, double hi, double *out, Error *err)
@@ -60,6 +65,10 @@ static bool parse_args(int argc, char **argv, StabCli *c, Error *err)
             if (!parse_number(a, argv[++i], 1, 1024, &num, err) || num != floor(num))
                 return error_set(err, "--threads expects an integer in [1, 1024], got '%s'", argv[i]);
             c->threads = (int)num;
+        } else if (!strcmp(a, "--jobs")) {
+            if (!parse_number(a, argv[++i], 1, 16, &num, err) || num != floor(num))
+                return error_set(err, "--jobs expects an integer in [1, 16], got '%s'", argv[i]);
+            c->jobs = (int)num;
         } else return error_set(err, "unknown option '%s'", a);
     }
     return true;
@@ -100,6 +109,7 @@ static void on_row(const StabResult *r, void *user)
 static void list_cases(void)
 {
     for (int i = 0; i < stab_case_count(); i++) printf("%-34s %s\n", stab_case_name(i), stab_case_doc(i));
+    printf("%-34s %s\n", "param_NAME", "--quick: every probe below of the parameter in one row");
     printf("%-34s %s\n", "param_NAME_{min,min_plus_1,max}", "each parameter at its bounds: finite output in [0,1]");
     printf("%-34s %s\n", "param_NAME_{below_min,above_max}", "just outside: refused naming the parameter and its range");
     printf("%-34s %s\n", "param_NAME_nonfinite", "NaN and +-Inf refused, also when handed raw to lab_render");
@@ -111,7 +121,8 @@ static bool run_suite(const StabCli *c, const Technique *t, Rows *rows, Error *e
     char work[] = "/tmp/shadowlab-stability-XXXXXX", scenes[1100];
     if (!mkdtemp(work)) return error_set(err, "cannot create a scratch folder in /tmp");
     snprintf(scenes, sizeof scenes, "%s/scenes", c->out ? c->out : "");
-    StabOptions o = {c->quick, c->timeout_s, c->threads, c->only, work, c->out ? scenes : NULL};
+    StabOptions o = {.quick = c->quick, .timeout_s = c->timeout_s, .threads = c->threads, .only = c->only,
+                     .work_dir = work, .scene_dir = c->out ? scenes : NULL, .jobs = c->jobs};
     const Technique *one[1] = {t};
     bool ok = stab_run(t ? one : NULL, t ? 1 : 0, t == NULL, &o, on_row, rows, err);
     rmdir(work);

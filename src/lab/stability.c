@@ -1,26 +1,28 @@
 /* stability.c -- the stability runner: expands the case table and every
- * technique's parameter declarations into runs, writes each run's scene, and
- * runs it in a forked child under a time bound, so a crash, a hang or a
- * sanitizer report becomes one failed row with its cause. The children do
- * the work (stability_exec.c); this process never starts a thread. */
+ * technique's parameter declarations into runs, groups the runs by the scene
+ * they need, and for each scene forks a case process (stability_proc.c)
+ * that builds what its runs share once, on one thread, then forks each run
+ * from it under a time bound, `jobs` at once. A crash, a hang or a
+ * sanitizer report is one failed row with its cause; this process never
+ * starts a thread. The runs' work is in stability_exec.c. */
 #define _POSIX_C_SOURCE 200809L
 #include "lab/stability.h"
-#include <dirent.h>
 #include <errno.h>
 #include <math.h>
-#include <poll.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 #include "core/fsutil.h"
 #include "core/timer.h"
 #include "io/exr.h"
 #include "lab/stability_cases.h"
+#include "lab/stability_proc.h"
 
 #define DEFAULT_TIMEOUT_S 120.0
+#define PREP_BOUNDS 3      /* a case's shared preparation: this many runs' time bound */
+#define CASE_SLACK_S 30.0  /* the case process between two results: a run's bound and this */
+#define MAX_JOBS 16
 
 const char *stab_status_name(StabStatus s)
 {
@@ -80,17 +82,48 @@ static void row_init(StabResult *r, const char *tech, const char *case_name, con
     r->mae = r->rmse = r->max_abs = r->noise_rms = NAN;
 }
 
+static bool has_light(const StabJob *j) { return !(j->c && j->c->plan == PLAN_NONE); }
+
+static void job_row(const StabJob *j, StabResult *r)
+{
+    row_init(r, j->tech ? j->tech->name : "-", j->name, has_light(j) ? light_kind_name(j->kind) : "");
+    r->order = j->order;
+}
+
+/* The whole matrix, planned before anything runs. */
 typedef struct Runner {
     const StabOptions *o;
     StabSettings st;
+    double timeout_s;
+    int jobs_at_once, threads;
     StabRowFn row;
     void *user;
-    int serial;
+    StabJob *jobs;
+    int num_jobs, cap, order, serial;
+    bool oom;
 } Runner;
 
 static bool wanted(const Runner *rn, const char *case_name)
 {
     return !rn->o->only || strstr(case_name, rn->o->only);
+}
+
+static void add_job(Runner *rn, const Technique *t, const StabCase *c, int param, ParamProbe probe, LightKind kind,
+                    const char *name)
+{
+    if (rn->num_jobs == rn->cap) {
+        int cap = rn->cap ? 2 * rn->cap : 256;
+        StabJob *p = realloc(rn->jobs, sizeof *p * (size_t)cap);
+        if (!p) {
+            rn->oom = true;
+            return;
+        }
+        rn->jobs = p;
+        rn->cap = cap;
+    }
+    StabJob *j = &rn->jobs[rn->num_jobs++];
+    *j = (StabJob){t, c, param, probe, kind, rn->st, rn->threads, rn->order++, ""};
+    snprintf(j->name, sizeof j->name, "%s", name);
 }
 
 /* ---- scene files --------------------------------------------------------------- */
@@ -161,169 +194,14 @@ static void build_spec(const StabJob *j, SceneSpec *s)
     }
 }
 
-/* ---- the child ------------------------------------------------------------------ */
-
-/* The line of a child's stderr that says most: a sanitizer's error line,
- * else any sanitizer line, else the last one. */
-static void log_excerpt(const char *log_path, char *out, size_t n)
-{
-    out[0] = '\0';
-    char *text = file_read_all(log_path, NULL, NULL);
-    if (!text) return;
-    char *error = NULL, *sanitizer = NULL, *last = NULL;
-    for (char *line = strtok(text, "\n"); line; line = strtok(NULL, "\n")) {
-        if (!error && (strstr(line, "ERROR: ") || strstr(line, "runtime error"))) error = line;
-        if (!sanitizer && strstr(line, "Sanitizer")) sanitizer = line;
-        if (line[strspn(line, " \t")]) last = line;
-    }
-    const char *best = error ? error : sanitizer ? sanitizer : last;
-    if (best) snprintf(out, n, "%.300s", best);
-    free(text);
-}
-
-static void child(const StabJob *j, const char *scene_path, const char *log_path, int fd, StabResult *r)
-{
-    FILE *log = freopen(log_path, "w", stderr);
-    (void)log;
-    stab_job_execute(j, scene_path, r);
-    size_t done = 0;
-    while (done < sizeof *r) {
-        ssize_t k = write(fd, (const char *)r + done, sizeof *r - done);
-        if (k <= 0) break;
-        done += (size_t)k;
-    }
-    close(fd);
-    exit(0); /* atexit handlers run, so LeakSanitizer checks the run */
-}
-
-/* Read the child's result until EOF or the deadline; true if all of it came. */
-static bool read_result(int fd, double deadline, StabResult *r)
-{
-    StabResult got;
-    size_t done = 0;
-    while (done < sizeof got) {
-        int ms = (int)fmax(0.0, (deadline - timer_now_s()) * 1000.0);
-        struct pollfd p = {fd, POLLIN, 0};
-        int k = poll(&p, 1, ms);
-        if (k < 0 && errno == EINTR) continue;
-        if (k <= 0) return false;
-        ssize_t n = read(fd, (char *)&got + done, sizeof got - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        done += (size_t)n;
-    }
-    *r = got;
-    return true;
-}
-
-/* Wait for the child until the deadline, then kill it. */
-static int reap(pid_t pid, double deadline, bool *killed)
-{
-    int status = 0;
-    *killed = false;
-    for (;;) {
-        pid_t w = waitpid(pid, &status, WNOHANG);
-        if (w == pid) return status;
-        if (w < 0 && errno != EINTR) return 0;
-        if (timer_now_s() > deadline) {
-            kill(pid, SIGKILL);
-            waitpid(pid, &status, 0);
-            *killed = true;
-            return status;
-        }
-        usleep(2000);
-    }
-}
-
-static void judge_exit(bool have_result, bool killed, int status, double timeout_s, const char *log_path, StabResult *r)
-{
-    char excerpt[320];
-    log_excerpt(log_path, excerpt, sizeof excerpt);
-    bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-    bool sanitizer = strstr(excerpt, "Sanitizer") || strstr(excerpt, "runtime error");
-    bool caught_signal = strstr(excerpt, "DEADLYSIGNAL") || strstr(excerpt, "SEGV on");
-    if (!killed && clean && have_result) return;
-    r->status = STAB_FAIL;
-    if (killed) snprintf(r->detail, sizeof r->detail, "no result within %.0f s (hang?) %s", timeout_s, excerpt);
-    else if (WIFSIGNALED(status))
-        snprintf(r->detail, sizeof r->detail, "crashed: signal %d (%s) %s", WTERMSIG(status),
-                 strsignal(WTERMSIG(status)), excerpt);
-    else if (caught_signal) snprintf(r->detail, sizeof r->detail, "crashed (signal caught by the sanitizer): %s", excerpt);
-    else if (sanitizer)
-        snprintf(r->detail, sizeof r->detail, "sanitizer report%s: %s", have_result ? " after the run" : "", excerpt);
-    else if (!clean) snprintf(r->detail, sizeof r->detail, "exit status %d: %s", WEXITSTATUS(status), excerpt);
-    else snprintf(r->detail, sizeof r->detail, "the child gave no result %s", excerpt);
-}
-
-static void run_isolated(const StabJob *j, const char *scene_path, const char *log_path, double timeout_s,
-                         StabResult *r)
-{
-    int fds[2];
-    if (pipe(fds) != 0) {
-        snprintf(r->detail, sizeof r->detail, "pipe: %s", strerror(errno));
-        return;
-    }
-    fflush(NULL);
-    double t0 = timer_now_s();
-    pid_t pid = fork();
-    if (pid < 0) {
-        snprintf(r->detail, sizeof r->detail, "fork: %s", strerror(errno));
-        close(fds[0]);
-        close(fds[1]);
-        return;
-    }
-    if (pid == 0) {
-        close(fds[0]);
-        child(j, scene_path, log_path, fds[1], r);
-    }
-    close(fds[1]);
-    double deadline = t0 + timeout_s;
-    bool have = read_result(fds[0], deadline, r);
-    close(fds[0]);
-    bool killed;
-    int status = reap(pid, deadline, &killed);
-    judge_exit(have, killed, status, timeout_s, log_path, r);
-    r->seconds = timer_now_s() - t0;
-    remove(log_path);
-}
-
-/* ---- one run ---------------------------------------------------------------------- */
-
-static void run_job(Runner *rn, const StabJob *j, const char *case_name)
-{
-    const char *tech = j->tech ? j->tech->name : "-";
-    bool has_light = !(j->c && j->c->plan == PLAN_NONE);
-    StabResult r;
-    row_init(&r, tech, case_name, has_light ? light_kind_name(j->kind) : "");
-    SceneSpec *s = malloc(sizeof *s);
-    if (!s) {
-        snprintf(r.detail, sizeof r.detail, "out of memory");
-        rn->row(&r, rn->user);
-        return;
-    }
-    build_spec(j, s);
-    Written w = {.num_files = s->num_files};
-    for (int i = 0; i < s->num_files; i++) snprintf(w.files[i], sizeof w.files[i], "%s", s->files[i].name);
-    char log_path[1100];
-    if (rn->o->scene_dir)
-        snprintf(w.dir, sizeof w.dir, "%s/%s-%s%s%s", rn->o->scene_dir, j->tech ? tech : "engine", case_name,
-                 has_light ? "-" : "", r.light);
-    else snprintf(w.dir, sizeof w.dir, "%s/run-%d", rn->o->work_dir, rn->serial);
-    snprintf(log_path, sizeof log_path, "%s/child-%d.log", rn->o->work_dir, rn->serial++);
-    Error err;
-    bool written = write_scene(s, j->kind, w.dir, w.scene_path, sizeof w.scene_path, &err);
-    free(s);
-    if (!written) snprintf(r.detail, sizeof r.detail, "cannot write the case: %s", err.msg);
-    else run_isolated(j, w.scene_path, log_path, rn->o->timeout_s > 0 ? rn->o->timeout_s : DEFAULT_TIMEOUT_S, &r);
-    if (!rn->o->scene_dir) remove_scene(&w);
-    rn->row(&r, rn->user);
-}
+/* ---- planning ---------------------------------------------------------------------- */
 
 static void not_applicable(Runner *rn, const Technique *t, const StabCase *c)
 {
     StabResult r;
     row_init(&r, t->name, c->name, "");
     r.status = STAB_NOT_APPLICABLE;
+    r.order = rn->order++;
     char handles[160], needs[160];
     tech_lights_text(t, handles, sizeof handles);
     Technique fake = {.lights = c->lights};
@@ -332,81 +210,276 @@ static void not_applicable(Runner *rn, const Technique *t, const StabCase *c)
     rn->row(&r, rn->user);
 }
 
-static void run_case(Runner *rn, const Technique *t, const StabCase *c)
+static void plan_case(Runner *rn, const Technique *t, const StabCase *c)
 {
     if (!wanted(rn, c->name)) return;
     LightKind kinds[8];
     int n = plan_kinds(c, t->lights, rn->st.quick, kinds);
-    if (n == 0) {
-        not_applicable(rn, t, c);
-        return;
-    }
-    for (int k = 0; k < n; k++) {
-        StabJob j = {t, c, -1, PROBE_NONE, kinds[k], rn->st, rn->o->threads};
-        run_job(rn, &j, c->name);
-    }
+    if (n == 0) not_applicable(rn, t, c);
+    for (int k = 0; k < n; k++) add_job(rn, t, c, -1, PROBE_NONE, kinds[k], c->name);
 }
 
-static bool probe_applies(const ParamDesc *p, ParamProbe probe)
-{
-    if (probe == PROBE_MIN_PLUS_ONE) return p->type == PARAM_INT && p->max >= p->min + 2;
-    return true;
-}
-
-static void run_param_probes(Runner *rn, const Technique *t)
+/* Each parameter's probes over the base scene: one row per probe, or in
+ * quick runs one row per parameter (unless --case picks single probes). */
+static void plan_param_probes(Runner *rn, const Technique *t)
 {
     LightKind kind;
     if (!first_of(any_order, 7, t->lights, &kind)) return;
     for (int i = 0; i < t->num_params; i++) {
-        for (int probe = PROBE_AT_MIN; probe < PROBE_COUNT; probe++) {
-            if (!probe_applies(&t->params[i], (ParamProbe)probe)) continue;
-            char name[STAB_NAME_MAX];
+        char name[STAB_NAME_MAX];
+        snprintf(name, sizeof name, "param_%s", t->params[i].name);
+        if (rn->st.quick && wanted(rn, name)) {
+            add_job(rn, t, NULL, i, PROBE_ALL, kind, name);
+            continue;
+        }
+        for (int probe = PROBE_AT_MIN; probe < PROBE_ALL; probe++) {
+            if (!stab_probe_applies(&t->params[i], (ParamProbe)probe)) continue;
             snprintf(name, sizeof name, "param_%s_%s", t->params[i].name, stab_probe_suffix((ParamProbe)probe));
-            if (!wanted(rn, name)) continue;
-            StabJob j = {t, NULL, i, (ParamProbe)probe, kind, rn->st, rn->o->threads};
-            run_job(rn, &j, name);
+            if (wanted(rn, name)) add_job(rn, t, NULL, i, (ParamProbe)probe, kind, name);
         }
     }
 }
 
-/* ---- the suite ----------------------------------------------------------------------- */
+/* ---- a case's process ----------------------------------------------------------------- */
 
-/* Forking is safe only while this process has one thread. */
-static int thread_count(void)
+/* The runs of one scene: the same case (NULL: the parameter probes' base
+ * scene) with the same light kind. */
+typedef struct CaseRun {
+    const Runner *rn;
+    const StabCase *c;
+    LightKind kind;
+    int *members; /* indices into rn->jobs */
+    int n;
+    char scene_path[1200];
+} CaseRun;
+
+typedef struct RunArg {
+    const StabJob *job;
+    const StabShared *sh;
+    StabResult r;
+} RunArg;
+
+static void run_body(void *arg, int fd)
 {
-    DIR *d = opendir("/proc/self/task");
-    if (!d) return 1;
-    int n = 0;
-    for (struct dirent *e; (e = readdir(d));) n += e->d_name[0] != '.';
-    closedir(d);
-    return n;
+    RunArg *a = arg;
+    stab_job_execute(a->job, a->sh, &a->r);
+    stab_proc_send(fd, &a->r);
 }
+
+static void log_name(const Runner *rn, int serial, const char *what, char *out, size_t n)
+{
+    snprintf(out, n, "%s/%s-%d-%ld.log", rn->o->work_dir, what, serial, (long)getpid());
+}
+
+/* A run's row: its result, unless it ended badly; the time and the case's
+ * shared preparation time either way. */
+static void finish_run(const StabProc *p, RunArg *a, double prep_s, int top_fd)
+{
+    StabResult r = p->results ? p->msg : a->r;
+    if (p->why[0]) {
+        r.status = STAB_FAIL;
+        snprintf(r.detail, sizeof r.detail, "%s", p->why);
+    } else if (!p->results) {
+        r.status = STAB_FAIL;
+        snprintf(r.detail, sizeof r.detail, "the run gave no result");
+    }
+    r.seconds = timer_now_s() - p->started_s;
+    r.prep_seconds = prep_s;
+    stab_proc_send(top_fd, &r);
+}
+
+/* Fork the case's runs from the prepared process, `jobs_at_once` at a time. */
+static void run_members(const CaseRun *cr, const StabShared *sh, double prep_s, int top_fd)
+{
+    const Runner *rn = cr->rn;
+    StabProc procs[MAX_JOBS], *active[MAX_JOBS];
+    RunArg args[MAX_JOBS];
+    bool busy[MAX_JOBS] = {false};
+    int slot_of[MAX_JOBS], n_active = 0, next = 0;
+    while (next < cr->n || n_active > 0) {
+        while (n_active < rn->jobs_at_once && next < cr->n) {
+            int slot = 0;
+            while (busy[slot]) slot++;
+            RunArg *a = &args[slot];
+            a->job = &rn->jobs[cr->members[next++]];
+            a->sh = sh;
+            job_row(a->job, &a->r);
+            char log[1100], why[256];
+            log_name(rn, slot, "run", log, sizeof log);
+            if (!stab_proc_spawn(&procs[slot], log, rn->timeout_s, 0, top_fd, run_body, a, why, sizeof why)) {
+                snprintf(a->r.detail, sizeof a->r.detail, "%s", why);
+                a->r.prep_seconds = prep_s;
+                stab_proc_send(top_fd, &a->r);
+                continue;
+            }
+            busy[slot] = true;
+            active[n_active] = &procs[slot];
+            slot_of[n_active++] = slot;
+        }
+        if (n_active == 0) continue;
+        StabEvent ev;
+        int k = stab_proc_next(active, n_active, &ev);
+        if (ev != STAB_EV_ENDED) continue;
+        finish_run(active[k], &args[slot_of[k]], prep_s, top_fd);
+        busy[slot_of[k]] = false;
+        active[k] = active[--n_active];
+        slot_of[k] = slot_of[n_active];
+    }
+}
+
+static void case_body(void *arg, int top_fd)
+{
+    const CaseRun *cr = arg;
+    const StabJob *first = &cr->rn->jobs[cr->members[0]];
+    StabShared sh;
+    StabResult why;
+    job_row(first, &why);
+    double t0 = timer_now_s();
+    bool ok = stab_prepare(cr->c, &first->st, cr->scene_path, &sh, &why);
+    int threads = stab_thread_count();
+    if (ok && threads > 1) {
+        snprintf(why.detail, sizeof why.detail,
+                 "the case's preparation left %d threads: its runs cannot be forked safely", threads);
+        ok = false;
+    }
+    double prep_s = timer_now_s() - t0;
+    if (ok) run_members(cr, &sh, prep_s, top_fd);
+    for (int i = 0; !ok && i < cr->n; i++) {
+        StabResult r;
+        job_row(&cr->rn->jobs[cr->members[i]], &r);
+        snprintf(r.detail, sizeof r.detail, "%s", why.detail);
+        r.prep_seconds = r.seconds = prep_s;
+        stab_proc_send(top_fd, &r);
+    }
+    stab_shared_release(&sh);
+}
+
+/* ---- one case, from this process -------------------------------------------------------- */
+
+static void fail_rows(const Runner *rn, const CaseRun *cr, const bool *delivered, const char *why)
+{
+    for (int i = 0; i < cr->n; i++) {
+        if (delivered && delivered[i]) continue;
+        StabResult r;
+        job_row(&rn->jobs[cr->members[i]], &r);
+        snprintf(r.detail, sizeof r.detail, "%s", why);
+        rn->row(&r, rn->user);
+    }
+}
+
+static void case_dir(const Runner *rn, const StabJob *j, char *out, size_t n)
+{
+    if (rn->o->scene_dir)
+        snprintf(out, n, "%s/%s%s%s", rn->o->scene_dir, j->c ? j->c->name : "params", has_light(j) ? "-" : "",
+                 has_light(j) ? light_kind_name(j->kind) : "");
+    else snprintf(out, n, "%s/case-%d", rn->o->work_dir, rn->serial);
+}
+
+/* Write the case's scene, run its process and pass its rows on; a run the
+ * process could not report (it crashed, hung or was killed) fails with why. */
+static void run_case(Runner *rn, CaseRun *cr)
+{
+    const StabJob *first = &rn->jobs[cr->members[0]];
+    SceneSpec *s = malloc(sizeof *s);
+    bool *delivered = calloc((size_t)cr->n, sizeof *delivered);
+    if (!s || !delivered) {
+        free(s);
+        free(delivered);
+        fail_rows(rn, cr, NULL, "out of memory");
+        return;
+    }
+    build_spec(first, s);
+    Written w = {.num_files = s->num_files};
+    for (int i = 0; i < s->num_files; i++) snprintf(w.files[i], sizeof w.files[i], "%s", s->files[i].name);
+    case_dir(rn, first, w.dir, sizeof w.dir);
+    Error err;
+    bool written = write_scene(s, first->kind, w.dir, w.scene_path, sizeof w.scene_path, &err);
+    free(s);
+    snprintf(cr->scene_path, sizeof cr->scene_path, "%s", w.scene_path);
+    char log[1100], why[STAB_DETAIL_MAX] = "";
+    log_name(rn, rn->serial++, "case", log, sizeof log);
+    StabProc p, *one[1] = {&p};
+    double first_bound = (PREP_BOUNDS + 1) * rn->timeout_s; /* the preparation, then the first run */
+    bool started = written && stab_proc_spawn(&p, log, first_bound, rn->timeout_s + CASE_SLACK_S, -1, case_body, cr,
+                                               why, sizeof why);
+    if (!written) snprintf(why, sizeof why, "cannot write the case: %s", err.msg);
+    if (started) {
+        StabEvent ev;
+        while (stab_proc_next(one, 1, &ev), ev == STAB_EV_RESULT) {
+            for (int i = 0; i < cr->n; i++)
+                if (rn->jobs[cr->members[i]].order == p.msg.order) delivered[i] = true;
+            rn->row(&p.msg, rn->user);
+        }
+        snprintf(why, sizeof why, "the case's process ended before this run: %s",
+                 p.why[0] ? p.why : "without its result");
+        if (p.why[0] && p.results == cr->n) { /* every run reported; the shared part failed afterwards */
+            StabResult r;
+            job_row(first, &r);
+            snprintf(r.technique, sizeof r.technique, "-");
+            snprintf(r.detail, sizeof r.detail, "the case's process, after its runs: %s", p.why);
+            rn->row(&r, rn->user);
+        }
+    }
+    fail_rows(rn, cr, delivered, why);
+    free(delivered);
+    if (!rn->o->scene_dir) remove_scene(&w);
+}
+
+/* Runs grouped by the scene they need, in the order each scene first appears. */
+static bool same_scene(const StabJob *a, const StabJob *b) { return a->c == b->c && a->kind == b->kind; }
+
+static void run_planned(Runner *rn)
+{
+    int *members = malloc(sizeof *members * (size_t)(rn->num_jobs ? rn->num_jobs : 1));
+    bool *done = calloc((size_t)rn->num_jobs + 1, sizeof *done);
+    for (int i = 0; members && done && i < rn->num_jobs; i++) {
+        if (done[i]) continue;
+        CaseRun cr = {.rn = rn, .c = rn->jobs[i].c, .kind = rn->jobs[i].kind, .members = members, .n = 0};
+        for (int j = i; j < rn->num_jobs; j++)
+            if (!done[j] && same_scene(&rn->jobs[i], &rn->jobs[j])) {
+                members[cr.n++] = j;
+                done[j] = true;
+            }
+        run_case(rn, &cr);
+    }
+    if (!members || !done) rn->oom = true;
+    free(members);
+    free(done);
+}
+
+/* ---- the suite ----------------------------------------------------------------------- */
 
 static StabSettings settings(bool quick)
 {
-    return quick ? (StabSettings){true, 40, 30, 16} : (StabSettings){false, 128, 96, 256};
+    return quick ? (StabSettings){true, STAB_QUICK_WIDTH, STAB_QUICK_HEIGHT, STAB_QUICK_REF_SAMPLES}
+                 : (StabSettings){false, 128, 96, 256};
 }
 
 bool stab_run(const Technique *const *techs, int n, bool engine_cases, const StabOptions *o, StabRowFn row,
               void *user, Error *err)
 {
     if (!o->work_dir) return error_set(err, "stability: no scratch folder");
-    int threads = thread_count();
+    int threads = stab_thread_count();
     if (threads > 1)
         return error_set(err, "stability: runs are forked, but this process already has %d threads", threads);
-    Runner rn = {o, settings(o->quick), row, user, 0};
+    if (o->jobs < 0 || o->jobs > MAX_JOBS) return error_set(err, "stability: jobs %d outside [1, %d]", o->jobs, MAX_JOBS);
+    Runner rn = {.o = o, .st = settings(o->quick), .row = row, .user = user};
+    rn.timeout_s = o->timeout_s > 0 ? o->timeout_s : DEFAULT_TIMEOUT_S;
+    rn.jobs_at_once = o->jobs > 0 ? o->jobs : 1;
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    rn.threads = o->threads > 0 ? o->threads : (int)fmax(1.0, (double)(cores > 0 ? cores : 1) / rn.jobs_at_once);
     int count = techs ? n : tech_count();
     for (int i = 0; i < count; i++) {
         const Technique *t = techs ? techs[i] : tech_at(i);
         for (int c = 0; c < stab_cases_count(); c++)
-            if (stab_cases_at(c)->plan != PLAN_NONE) run_case(&rn, t, stab_cases_at(c));
-        run_param_probes(&rn, t);
+            if (stab_cases_at(c)->plan != PLAN_NONE) plan_case(&rn, t, stab_cases_at(c));
+        plan_param_probes(&rn, t);
     }
     for (int c = 0; engine_cases && c < stab_cases_count(); c++) {
         const StabCase *sc = stab_cases_at(c);
-        if (sc->plan != PLAN_NONE || !wanted(&rn, sc->name)) continue;
-        StabJob j = {NULL, sc, -1, PROBE_NONE, LIGHT_POINT, rn.st, o->threads};
-        run_job(&rn, &j, sc->name);
+        if (sc->plan == PLAN_NONE && wanted(&rn, sc->name)) add_job(&rn, NULL, sc, -1, PROBE_NONE, LIGHT_POINT, sc->name);
     }
-    return true;
+    if (!rn.oom) run_planned(&rn);
+    free(rn.jobs);
+    return !rn.oom || error_set(err, "stability: out of memory for the runs");
 }

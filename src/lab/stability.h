@@ -3,7 +3,8 @@
  * techniques come from the registry or from the caller, so a technique is
  * covered the day it is registered. Each run happens in a forked child with a
  * time bound, so a crash, hang or sanitizer report is one failed row, not the
- * end of the suite. Asserted: output finite and in [0,1] on every lit
+ * end of the suite; runs on one case share its scene, BVH, view samples and
+ * reference, built once in the process they are forked from. Asserted: output finite and in [0,1] on every lit
  * candidate, the documented limit where one exists, and refusals of invalid
  * input that name the parameter or key and its range. */
 #ifndef SL_STABILITY_H
@@ -14,13 +15,22 @@ typedef enum StabStatus { STAB_PASS, STAB_FAIL, STAB_NOT_APPLICABLE } StabStatus
 const char *stab_status_name(StabStatus s);
 
 typedef struct StabOptions {
-    bool quick;            /* reduced sizes and reference samples (make test); every case still runs */
-    double timeout_s;      /* per run; 0: 120 s */
-    int threads;           /* per run; 0: all cores */
+    bool quick;            /* reduced sizes (STAB_QUICK_*), one row per parameter (make test); every case still runs */
+    double timeout_s;      /* per run; 0: 120 s. A case's shared preparation gets 3 times this */
+    int threads;           /* per run; 0: the cores divided among the concurrent runs */
     const char *only;      /* run only cases whose name contains this; NULL: all */
     const char *work_dir;  /* existing scratch folder for scene files and child logs */
     const char *scene_dir; /* if set, every case's scene file is kept there (to reproduce a row) */
+    int jobs;              /* runs at once; 0: 1 */
 } StabOptions;
+
+/* Quick runs: view size, reference light samples, and the cap on integer
+ * parameters counted in texels (map resolutions) except in their own
+ * probes; the full matrix keeps every default. */
+#define STAB_QUICK_WIDTH 40
+#define STAB_QUICK_HEIGHT 30
+#define STAB_QUICK_REF_SAMPLES 16
+#define STAB_QUICK_TEXELS 128
 
 #define STAB_NAME_MAX 80
 #define STAB_DETAIL_MAX 640
@@ -39,12 +49,14 @@ typedef struct StabResult {
     double noise_rms;            /* the reference's own noise */
     int ref_samples;             /* light samples of that reference */
     double seconds;              /* wall time of the run, child start to exit */
+    double prep_seconds;         /* the case's shared preparation (scene, BVH, view samples, reference) */
+    int order;                   /* position in the matrix (technique-major); rows arrive as runs finish */
 } StabResult;
 
 typedef void (*StabRowFn)(const StabResult *row, void *user);
 
 /* Run the suite for `techs` (n entries; NULL: every registered technique),
- * calling `row` after each run. Engine input cases run once, with technique
+ * calling `row` after each run, in the order runs finish. Engine input cases run once, with technique
  * "-", unless `engine_cases` is false. Children are forked, so the calling
  * process must not have started threads yet (no Embree device, no OpenMP
  * region): this is checked. Returns false (err set) only when the suite
@@ -57,8 +69,8 @@ int stab_case_count(void);
 const char *stab_case_name(int i);
 const char *stab_case_doc(int i);
 
-/* Write DIR/stability.{json,csv,md} atomically: the matrix with counts,
- * errors and times, and the options it ran with. */
+/* Write DIR/stability.{json,csv,md} atomically: the matrix (rows in their
+ * `order`) with counts, errors and times, and the options it ran with. */
 bool stab_report_write(const char *dir, const StabResult *rows, int n, const StabOptions *o, Error *err);
 
 #endif

@@ -8,6 +8,7 @@
 #define SL_STABILITY_CASES_H
 #include <stddef.h>
 #include "metrics/metrics.h"
+#include "lab/lab.h"
 #include "lab/stability.h"
 #include "scene/scene.h"
 
@@ -63,6 +64,7 @@ typedef struct StabCase {
     LightPlan plan;
     bool heavy;                    /* reduced reference samples */
     bool may_refuse;               /* a technique may refuse it with a clear message */
+    bool default_maps;             /* its limit is stated at the default map sizes: quick runs keep them */
     void (*build)(SceneSpec *s, LightKind kind, const StabSettings *st);
     /* Documented limit on the metrics against the reference; NULL: none.
      * Returns false with the reason in `why`. */
@@ -76,6 +78,7 @@ typedef enum ParamProbe {
     PROBE_AT_MIN, PROBE_MIN_PLUS_ONE, PROBE_AT_MAX, /* render at the value */
     PROBE_BELOW_MIN, PROBE_ABOVE_MAX,                /* refused naming the parameter and its range */
     PROBE_NONFINITE,                                 /* NaN and +-Inf refused, also raw in lab_render */
+    PROBE_ALL,                                       /* quick runs: every probe above in one run */
     PROBE_COUNT
 } ParamProbe;
 
@@ -89,13 +92,31 @@ typedef struct StabJob {
     LightKind kind;
     StabSettings st;
     int threads;
+    int order;                  /* the row's position in the matrix */
+    char name[STAB_NAME_MAX];   /* the row's case name */
 } StabJob;
+
+/* What every run on one scene shares, built once in the process the runs
+ * are forked from (copy on write): the loaded scene and its BVH, the view
+ * samples, classes and reference in the Lab's resource manager. Built on
+ * one thread, so that forking it is safe. lab is NULL for engine input
+ * cases, whose runs load (and must be refused) the scene themselves. */
+typedef struct StabShared {
+    Lab *lab;
+    const char *scene_path;
+} StabShared;
+
+/* Open the scene of `c` (NULL: the base scene of parameter probes) and build
+ * the shared resources; false with the reason in r->detail. */
+bool stab_prepare(const StabCase *c, const StabSettings *st, const char *scene_path, StabShared *sh, StabResult *r);
+void stab_shared_release(StabShared *sh);
 
 /* The value a render probe sets, or the refused value of BELOW/ABOVE. */
 double stab_probe_value(const ParamDesc *p, ParamProbe probe);
 const char *stab_probe_suffix(ParamProbe probe);
-/* Runs in the forked child: the job on the scene file, results into r. */
-void stab_job_execute(const StabJob *j, const char *scene_path, StabResult *r);
+bool stab_probe_applies(const ParamDesc *p, ParamProbe probe);
+/* Runs in the forked child: the job on the shared scene, results into r. */
+void stab_job_execute(const StabJob *j, const StabShared *sh, StabResult *r);
 
 int stab_cases_count(void);
 const StabCase *stab_cases_at(int i);

@@ -1,15 +1,17 @@
-/* stability_exec.c -- what one stability run does, inside its forked child:
- * load the case's scene, render the technique (with a parameter probe's
- * value), count non-finite and out-of-range outputs over the lit candidates,
- * measure the error against a cheap reference, and check the case's limit;
- * or check that bad input is refused with a message naming what is wrong. */
+/* stability_exec.c -- what the stability suite's processes do: a case's
+ * shared preparation (its scene, BVH, view samples, classes and reference,
+ * on one thread), and one run forked from it: render the technique (with a
+ * parameter probe's value), count non-finite and out-of-range outputs over
+ * the lit candidates, measure the error against the cheap reference and
+ * check the case's limit; or check that bad input is refused with a message
+ * naming what is wrong. */
 #include <math.h>
 #include <stdarg.h>
 #include <omp.h>
 #include <stdio.h>
 #include <string.h>
 #include "lab/stability_cases.h"
-#include "lab/lab.h"
+#include "rt/rt.h"
 
 static bool fail(StabResult *r, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static bool fail(StabResult *r, const char *fmt, ...)
@@ -37,8 +39,14 @@ static void note(StabResult *r, const char *fmt, ...)
 const char *stab_probe_suffix(ParamProbe probe)
 {
     static const char *const names[PROBE_COUNT] = {"", "min", "min_plus_1", "max", "below_min", "above_max",
-                                                   "nonfinite"};
+                                                   "nonfinite", "all"};
     return names[probe];
+}
+
+bool stab_probe_applies(const ParamDesc *p, ParamProbe probe)
+{
+    if (probe == PROBE_MIN_PLUS_ONE) return p->type == PARAM_INT && p->max >= p->min + 2;
+    return true;
 }
 
 double stab_probe_value(const ParamDesc *p, ParamProbe probe)
@@ -122,9 +130,24 @@ static void run_param_refusal(const StabJob *j, Lab *lab, StabResult *r)
 
 /* ---- rendering -------------------------------------------------------------- */
 
+/* Quick runs cap the technique's integer texel counts (map resolutions) at
+ * STAB_QUICK_TEXELS, except the parameter being probed and in cases whose
+ * limit is stated at the default sizes. */
+static void quick_caps(const StabJob *j, double *vals)
+{
+    bool cap = j->st.quick && !(j->c && j->c->default_maps);
+    for (int i = 0; cap && i < j->tech->num_params; i++) {
+        const ParamDesc *p = &j->tech->params[i];
+        if (i != j->param && p->type == PARAM_INT && !strcmp(p->unit, "texels") && vals[i] > STAB_QUICK_TEXELS &&
+            p->min <= STAB_QUICK_TEXELS)
+            vals[i] = STAB_QUICK_TEXELS;
+    }
+}
+
 static bool probe_params(const StabJob *j, double *vals, StabResult *r)
 {
     tech_params_default(j->tech, vals);
+    quick_caps(j, vals);
     if (j->probe == PROBE_NONE) return true;
     const ParamDesc *p = &j->tech->params[j->param];
     double v = stab_probe_value(p, j->probe);
@@ -149,12 +172,20 @@ static void count_outputs(const Image *v, const uint8_t *cls, StabResult *r)
     }
 }
 
-static int reference_samples(const StabJob *j) { return j->c && j->c->heavy ? 16 : j->st.ref_samples; }
+/* The cheap reference of a case (NULL: parameter probes); heavy cases take
+ * 16 light samples, and none at all in quick runs (their output is checked,
+ * not its error). */
+static bool measured(const StabCase *c, const StabSettings *st) { return !(st->quick && c && c->heavy); }
 
-/* Error against a cheap reference; the case's limit if it has one. */
+static RefRequest reference_request(const StabCase *c, const StabSettings *st)
+{
+    return (RefRequest){0, {MEASURE_VISIBILITY, c && c->heavy ? 16 : st->ref_samples, SAMPLING_R2, 1}, NULL};
+}
+
+/* Error against the reference; the case's limit if it has one. */
 static bool measure(const StabJob *j, Lab *lab, const Image *v, const uint8_t *cls, StabResult *r)
 {
-    RefRequest rq = {0, {MEASURE_VISIBILITY, reference_samples(j), SAMPLING_R2, 1}, NULL};
+    RefRequest rq = reference_request(j->c, &j->st);
     RefInfo info;
     Error e;
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &e);
@@ -197,8 +228,7 @@ static void run_render(const StabJob *j, Lab *lab, StabResult *r)
         return;
     }
     count_outputs(&out.visibility, cls, r);
-    /* Quick runs of heavy cases check the output, not its error (no reference). */
-    bool ok = (j->st.quick && j->c && j->c->heavy) || measure(j, lab, &out.visibility, cls, r);
+    bool ok = !measured(j->c, &j->st) || measure(j, lab, &out.visibility, cls, r);
     render_result_free(&out);
     if (!ok) return;
     if (r->nonfinite || r->out_of_range)
@@ -228,21 +258,79 @@ static void run_scene_refusal(const StabJob *j, const char *path, StabResult *r)
     snprintf(r->detail, sizeof r->detail, "refused: %s", e.msg);
 }
 
-void stab_job_execute(const StabJob *j, const char *scene_path, StabResult *r)
+/* ---- a parameter's probes in one run (quick) ----------------------------------- */
+
+static void run_probe(const StabJob *j, Lab *lab, StabResult *r)
 {
-    if (j->threads > 0) omp_set_num_threads(j->threads);
-    rt_set_threads(j->threads > 0 ? j->threads : omp_get_max_threads());
-    if (j->c && j->c->plan == PLAN_NONE) {
-        run_scene_refusal(j, scene_path, r);
-        return;
-    }
-    Error e;
-    Lab *lab = lab_open(scene_path, NULL, 0, &e);
-    if (!lab) {
-        fail(r, "the case's scene was refused: %s", e.msg);
-        return;
-    }
     if (j->probe >= PROBE_BELOW_MIN) run_param_refusal(j, lab, r);
     else run_render(j, lab, r);
-    lab_close(lab);
+}
+
+/* Counts add up, errors take the worst probe; the first failure ends the
+ * row, named by its probe. */
+static void run_all_probes(const StabJob *j, Lab *lab, StabResult *r)
+{
+    const ParamDesc *p = &j->tech->params[j->param];
+    r->status = STAB_PASS;
+    for (int probe = PROBE_AT_MIN; probe < PROBE_ALL; probe++) {
+        if (!stab_probe_applies(p, (ParamProbe)probe)) continue;
+        StabJob one = *j;
+        one.probe = (ParamProbe)probe;
+        StabResult part = {.status = STAB_FAIL, .mae = NAN, .rmse = NAN, .max_abs = NAN, .noise_rms = NAN};
+        run_probe(&one, lab, &part);
+        r->samples += part.samples;
+        r->nonfinite += part.nonfinite;
+        r->out_of_range += part.out_of_range;
+        r->mae = fmax(r->mae, part.mae);
+        r->rmse = fmax(r->rmse, part.rmse);
+        r->max_abs = fmax(r->max_abs, part.max_abs);
+        r->noise_rms = fmax(r->noise_rms, part.noise_rms);
+        if (part.ref_samples > r->ref_samples) r->ref_samples = part.ref_samples;
+        if (part.status != STAB_PASS) {
+            fail(r, "%s: %s", stab_probe_suffix((ParamProbe)probe), part.detail);
+            return;
+        }
+        note(r, "%s", part.detail);
+    }
+}
+
+/* ---- the case's shared preparation and the runs ---------------------------------- */
+
+bool stab_prepare(const StabCase *c, const StabSettings *st, const char *scene_path, StabShared *sh, StabResult *r)
+{
+    sh->lab = NULL;
+    sh->scene_path = scene_path;
+    if (c && c->plan == PLAN_NONE) return true;
+    omp_set_num_threads(1); /* no thread may exist when the runs are forked */
+    rt_set_threads(1);
+    Error e;
+    sh->lab = lab_open(scene_path, NULL, 0, &e);
+    if (!sh->lab) return fail(r, "the case's scene was refused: %s", e.msg);
+    ResourceManager *rm = lab_resources(sh->lab);
+    const Scene *sc = lab_scene(sh->lab);
+    if (!res_view_samples(rm, sc, &e) || !res_classes(rm, sc, 0, &e))
+        return fail(r, "view samples failed: %s", e.msg);
+    RefRequest rq = reference_request(c, st);
+    RefInfo info;
+    if (measured(c, st) && !res_reference(rm, sc, &rq, &info, &e)) return fail(r, "reference failed: %s", e.msg);
+    return true;
+}
+
+void stab_shared_release(StabShared *sh)
+{
+    lab_close(sh->lab);
+    sh->lab = NULL;
+}
+
+/* Runs with the case's Embree device, made on one thread by the preparation;
+ * OpenMP starts this run's own threads. */
+void stab_job_execute(const StabJob *j, const StabShared *sh, StabResult *r)
+{
+    if (j->threads > 0) omp_set_num_threads(j->threads);
+    if (!sh->lab) {
+        run_scene_refusal(j, sh->scene_path, r);
+        return;
+    }
+    if (j->probe == PROBE_ALL) run_all_probes(j, sh->lab, r);
+    else run_probe(j, sh->lab, r);
 }

@@ -18,7 +18,10 @@
 
 /* ---- techniques that misbehave on purpose ------------------------------------ */
 
-typedef enum Misbehaviour { OK_HALF, GIVES_NAN, GIVES_1_5, CRASHES, HANGS, OVERFLOWS, LEAKS, REFUSES, ALWAYS_LIT } Misbehaviour;
+typedef enum Misbehaviour {
+    OK_HALF, GIVES_NAN, GIVES_1_5, CRASHES, HANGS, OVERFLOWS, LEAKS, REFUSES, ALWAYS_LIT,
+    NAN_UNLESS_CAPPED /* 0.5 while map_res is at most STAB_QUICK_TEXELS, else NaN */
+} Misbehaviour;
 
 static Misbehaviour current;
 
@@ -40,9 +43,11 @@ static bool fake_prepare(const TechContext *ctx, void **state, Error *err)
 static void fake_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
 {
     (void)state;
-    static const float values[] = {[OK_HALF] = 0.5f, [GIVES_1_5] = 1.5f, [ALWAYS_LIT] = 1.0f};
+    static const float values[] = {[OK_HALF] = 0.5f, [GIVES_1_5] = 1.5f, [ALWAYS_LIT] = 1.0f,
+                                   [NAN_UNLESS_CAPPED] = 0.5f};
+    bool capped = ctx->params[2] <= STAB_QUICK_TEXELS;
     for (int s = begin; s < end; s++) {
-        float v = current == GIVES_NAN ? NAN : values[current];
+        float v = current == GIVES_NAN || (current == NAN_UNLESS_CAPPED && !capped) ? NAN : values[current];
         if (current == CRASHES) raise(SIGSEGV);
         if (current == OVERFLOWS) {
             volatile char *p = malloc(8);
@@ -56,13 +61,14 @@ static void fake_evaluate(const void *state, const TechContext *ctx, int begin, 
 static const ParamDesc fake_params[] = {
     {"weight", PARAM_FLOAT, 0.5, 0.0, 1.0, "", "a float parameter", NULL},
     {"taps", PARAM_INT, 4, 1, 64, "texels", "an int parameter", NULL},
+    {"map_res", PARAM_INT, 1024, 1, 4096, "texels", "a map resolution (capped in quick runs)", NULL},
 };
 static const char *const no_resources[] = {NULL};
 
 static Technique fake(const char *name, unsigned lights)
 {
     return (Technique){.name = name, .family = "test", .source = "selftest", .summary = "misbehaves on purpose",
-                       .params = fake_params, .num_params = 2, .resources = no_resources, .rgb = true,
+                       .params = fake_params, .num_params = 3, .resources = no_resources, .rgb = true,
                        .lights = lights, .prepare = fake_prepare, .evaluate = fake_evaluate, .release = NULL};
 }
 
@@ -78,17 +84,28 @@ static void collect(const StabResult *r, void *user)
     if (c->n < 64) c->rows[c->n++] = *r;
 }
 
-static Collected run(Misbehaviour m, unsigned lights, const char *only, double timeout_s)
+static void report(const char *name, bool ok, const Collected *c)
+{
+    printf("%s %s\n", ok ? "ok  " : "FAIL", name);
+    for (int i = 0; !ok && i < c->n; i++)
+        printf("    %s %s %s[%s] prep %.6f s: %s\n", stab_status_name(c->rows[i].status), c->rows[i].technique,
+               c->rows[i].case_name, c->rows[i].light, c->rows[i].prep_seconds, c->rows[i].detail);
+    fflush(stdout);
+    ok ? passed++ : failed++;
+}
+
+/* `copies` fake techniques, two runs at once. */
+static Collected run(Misbehaviour m, unsigned lights, const char *only, int copies)
 {
     current = m;
-    Technique t = fake("fake", lights);
-    const Technique *list[1] = {&t};
+    Technique t[2] = {fake("fake", lights), fake("fake2", lights)};
+    const Technique *list[2] = {&t[0], &t[1]};
     char work[] = "/tmp/shadowlab-selftest-XXXXXX";
     Collected c = {.n = 0};
     if (!mkdtemp(work)) return c;
-    StabOptions o = {true, timeout_s, 1, only, work, NULL};
+    StabOptions o = {.quick = true, .timeout_s = 5.0, .threads = 1, .only = only, .work_dir = work, .jobs = 2};
     Error err;
-    if (!stab_run(list, 1, false, &o, collect, &c, &err)) printf("    stab_run: %s\n", err.msg);
+    if (!stab_run(list, copies, false, &o, collect, &c, &err)) printf("    stab_run: %s\n", err.msg);
     rmdir(work);
     return c;
 }
@@ -97,18 +114,26 @@ static Collected run(Misbehaviour m, unsigned lights, const char *only, double t
 static void expect(const char *name, Misbehaviour m, unsigned lights, const char *only, StabStatus status,
                    const char *word)
 {
-    Collected c = run(m, lights, only, 5.0);
+    Collected c = run(m, lights, only, 1);
     bool ok = c.n > 0;
     for (int i = 0; ok && i < c.n; i++)
         ok = c.rows[i].status == status && (!word || strstr(c.rows[i].detail, word));
-    printf("%s %s", ok ? "ok  " : "FAIL", name);
-    if (!ok) {
-        printf(": expected %s with '%s'; got %d rows", stab_status_name(status), word ? word : "", c.n);
-        for (int i = 0; i < c.n; i++) printf("\n    %s %s[%s]: %s", stab_status_name(c.rows[i].status), c.rows[i].case_name, c.rows[i].light, c.rows[i].detail);
-    }
-    printf("\n");
-    fflush(stdout);
-    ok ? passed++ : failed++;
+    report(name, ok, &c);
+    if (!ok) printf("    expected %s with '%s'\n", stab_status_name(status), word ? word : "");
+}
+
+/* Two techniques on one case: each light kind's rows come from one shared
+ * preparation (the same prep_seconds, to the bit) and each ran on its own. */
+static void expect_shared_preparation(void)
+{
+    Collected c = run(OK_HALF, LIGHTS_ALL, "contact", 2);
+    bool ok = c.n == 4;
+    for (int i = 0; ok && i < c.n; i++)
+        for (int k = 0; k < c.n; k++)
+            if (!strcmp(c.rows[i].light, c.rows[k].light))
+                ok = ok && c.rows[i].status == STAB_PASS && c.rows[i].prep_seconds == c.rows[k].prep_seconds &&
+                     c.rows[i].prep_seconds > 0 && (i == k || strcmp(c.rows[i].technique, c.rows[k].technique));
+    report("harness_runs_share_the_case_preparation", ok, &c);
 }
 
 static void selftests(void)
@@ -130,6 +155,11 @@ static void selftests(void)
     expect("harness_params_at_bounds_render", OK_HALF, all, "param_taps_m", STAB_PASS, "taps = ");
     expect("harness_params_outside_are_refused_with_range", OK_HALF, all, "param_weight_above", STAB_PASS, NULL);
     expect("harness_nonfinite_params_are_refused", OK_HALF, all, "param_taps_nonfinite", STAB_PASS, NULL);
+    expect("harness_quick_merges_a_parameters_probes", OK_HALF, all, "param_taps", STAB_PASS, "taps = 64");
+    expect("harness_merged_probes_name_the_failing_one", GIVES_NAN, all, "param_weight", STAB_FAIL, "min: ");
+    expect("harness_quick_caps_map_sizes", NAN_UNLESS_CAPPED, all, "contact", STAB_PASS, NULL);
+    expect("harness_quick_probes_the_cap_itself", NAN_UNLESS_CAPPED, all, "param_map_res", STAB_FAIL, "max: ");
+    expect_shared_preparation();
 }
 
 /* The engine under the sanitizers on every extreme case: `hard` (the
@@ -155,7 +185,7 @@ int main(void)
     Error err;
     const Technique *hard = tech_find("hard", &err);
     char work[] = "/tmp/shadowlab-sanitized-XXXXXX";
-    StabOptions o = {true, 0, 0, NULL, work, NULL};
+    StabOptions o = {.quick = true, .threads = 1, .work_dir = work, .jobs = 2};
     bool ran = hard && mkdtemp(work) && stab_run(&hard, 1, true, &o, print_row, NULL, &err);
     if (!ran) printf("    %s\n", err.msg);
     rmdir(work);
