@@ -26,8 +26,9 @@ enum { P_THRESHOLD = SMAP_NUM_PARAMS, P_MAX_LEVEL, P_COLOR_THRESHOLD, P_FIXED, P
 /* Cuts of the search cone at the nearest possible blocker (search_depth). */
 #define AA_SEARCH_REFINEMENTS 3
 
+/* One plain perspective map (light_axes): no warps, cascades or face splits. */
 static const ParamDesc aa_params[] = {
-    SMAP_MAP_PARAMS,
+    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_PERSPECTIVE, 1, SPLIT_UNIFORM),
     SMAP_BIAS_PARAMS_PLANE(1),
     {"threshold", PARAM_FLOAT, 0.2244, 0, 0.25, "",
      "visibility variance E - E^2 above which a region splits into 4 (seed 001 §3: 0.2244; Fig. 2: 0.10, 0.22, 0.24)",
@@ -53,6 +54,15 @@ static const char *const aa_resources[] = {"shadow_map", "minmax_pyramid", "ligh
  * Table 1's frame rates measure, independent of the machine's load. */
 static const char *const aa_aux[] = {"level", "tests", NULL};
 
+/* Per map face: the light's width and height vectors in texel units per
+ * unit of k = 1/z - 1/z_p (seed 001 §3's cone: a light point q maps through
+ * the receiver onto the plane at depth z at tangent T_p + q_view.xy k), and
+ * the face's near plane (world units). */
+typedef struct FaceAxes {
+    double right_s, right_t, up_s, up_t;
+    double near_depth;
+} FaceAxes;
+
 typedef struct AaState {
     const ShadowMap *map;
     const MinMaxPyramid *pyramid;
@@ -60,11 +70,7 @@ typedef struct AaState {
     double threshold, color_threshold;
     int max_level, taps, search_taps;
     bool fixed;
-    /* The light's width and height vectors in texel units per unit of
-     * k = 1/z - 1/z_p (seed 001 §3's cone: a light point q maps through the
-     * receiver onto the plane at depth z at tangent T_p + q_view.xy k). */
-    double right_s, right_t, up_s, up_t;
-    double near_depth;              /* the map's near plane, world units */
+    FaceAxes face[LIGHTVIEW_MAX_FACES];
     /* Per quad-tree node (level L, cell x, y at index (4^L - 1)/3 + y 2^L + x):
      * the mean colour of its part of the light and its colour variance. */
     float node_color[AA_MAX_NODES][3];
@@ -98,25 +104,29 @@ static bool node_colors(const TechContext *ctx, AaState *st, Error *err)
     return true;
 }
 
-/* The light's edges in the map's texel units per unit k (see AaState). */
+/* The light's edges in each face's texel units per unit k (see FaceAxes).
+ * Every face must be a plain perspective frustum from the light's centre
+ * looking along its normal (one map, or cascades of it): then the light lies
+ * in the plane of depth 0 and its back-projections are affine in (u, v). */
 static bool light_axes(const TechContext *ctx, AaState *st, Error *err)
 {
     const LightView *lv = &st->map->view;
-    const MapFace *f = &lv->face[0];
-    if (lv->projection != MAP_PROJ_PERSPECTIVE || lv->num_faces != 1)
-        return error_set(err, "the filter region is the light's cone on one plain perspective map; projection %s "
-                              "gives %d face(s) (use auto or perspective, one cascade)",
-                         map_projection_name(lv->projection), lv->num_faces);
     const Light *l = ctx->light;
     dvec3 c = d3_from(l->position), right = d3_from(v3_cross(l->up, l->direction)), up = d3_from(l->up);
-    dvec4 r_view = m4_apply(&f->view_from_world, d3_madd(c, right, l->width));
-    dvec4 u_view = m4_apply(&f->view_from_world, d3_madd(c, up, l->height));
-    double s_per_tan = lv->res / (f->r - f->l), t_per_tan = lv->res / (f->t - f->b);
-    st->right_s = r_view.x * s_per_tan;
-    st->right_t = r_view.y * t_per_tan;
-    st->up_s = u_view.x * s_per_tan;
-    st->up_t = u_view.y * t_per_tan;
-    st->near_depth = f->raster.depth_near;
+    for (int k = 0; k < lv->num_faces; k++) {
+        const MapFace *f = &lv->face[k];
+        bool plain = lv->projection == MAP_PROJ_PERSPECTIVE && f->perspective && f->warp == MAP_WARP_NONE &&
+                     d3_dot(f->axis_world, d3_from(l->direction)) > 1.0 - 1e-6; /* float normals */
+        if (!plain)
+            return error_set(err, "the filter region is the light's cone on perspective maps looking along the "
+                                  "light's normal; projection %s is not one (use auto or perspective)",
+                             map_projection_name(lv->projection));
+        dvec4 r_view = m4_apply(&f->view_from_world, d3_madd(c, right, l->width));
+        dvec4 u_view = m4_apply(&f->view_from_world, d3_madd(c, up, l->height));
+        double s_per_tan = lv->res / (f->r - f->l), t_per_tan = lv->res / (f->t - f->b);
+        st->face[k] = (FaceAxes){r_view.x * s_per_tan, r_view.y * t_per_tan, u_view.x * s_per_tan,
+                                 u_view.y * t_per_tan, f->raster.depth_near};
+    }
     return true;
 }
 
@@ -147,18 +157,19 @@ static bool aa_prepare(const TechContext *ctx, void **state, Error *err)
 typedef struct Region {
     const AaState *st;
     const SmapReceiver *r;
+    const FaceAxes *ax; /* of the receiver's face */
     double k;
 } Region;
 
 /* Texel of light point (u, v) through the region; false outside the map. */
 static bool region_texel(const Region *g, double u, double v, int *i, int *j)
 {
-    const AaState *st = g->st;
+    const FaceAxes *a = g->ax;
     double du = (u - 0.5) * g->k, dv = (v - 0.5) * g->k;
-    double s = g->r->mc.s + du * st->right_s + dv * st->up_s, t = g->r->mc.t + du * st->right_t + dv * st->up_t;
+    double s = g->r->mc.s + du * a->right_s + dv * a->up_s, t = g->r->mc.t + du * a->right_t + dv * a->up_t;
     *i = (int)floor(s);
     *j = (int)floor(t);
-    return *i >= 0 && *j >= 0 && *i < st->map->res && *j < st->map->res;
+    return *i >= 0 && *j >= 0 && *i < g->st->map->res && *j < g->st->map->res;
 }
 
 /* The depth where the blocker search cuts the cone (seed 001 §3: "the
@@ -173,10 +184,11 @@ static bool region_texel(const Region *g, double u, double v, int *i, int *j)
 static double search_depth(const AaState *st, const SmapReceiver *r, double z_receiver)
 {
     int face = r->mc.face;
-    double z = st->near_depth;
+    const FaceAxes *a = &st->face[face];
+    double z = a->near_depth;
     for (int it = 0; it < AA_SEARCH_REFINEMENTS; it++) {
         double k = 1.0 / z - 1.0 / z_receiver;
-        double hs = 0.5 * k * (fabs(st->right_s) + fabs(st->up_s)), ht = 0.5 * k * (fabs(st->right_t) + fabs(st->up_t));
+        double hs = 0.5 * k * (fabs(a->right_s) + fabs(a->up_s)), ht = 0.5 * k * (fabs(a->right_t) + fabs(a->up_t));
         float lo, hi;
         minmax_query(st->pyramid, face, (int)floor(r->mc.s - hs), (int)floor(r->mc.t - ht), (int)floor(r->mc.s + hs),
                      (int)floor(r->mc.t + ht), &lo, &hi);
@@ -195,7 +207,7 @@ static double average_blocker_depth(const AaState *st, const SmapReceiver *r, do
     double z_search = search_depth(st, r, z_receiver);
     if (!(z_search > 0.0)) return 0.0;
     *tests = st->search_taps * st->search_taps;
-    Region g = {st, r, 1.0 / z_search - 1.0 / z_receiver};
+    Region g = {st, r, &st->face[r->mc.face], 1.0 / z_search - 1.0 / z_receiver};
     int n = st->search_taps, found = 0;
     double sum = 0.0;
     for (int b = 0; b < n; b++)
@@ -274,7 +286,7 @@ static int shade_receiver(const AaState *st, const SmapReceiver *r, int channels
     /* The plane of the average blocker: z_avg >= near > 0 and z_avg < z_p
      * (blockers lie in front of the biased receiver), so k >= 0; k -> 0 at
      * contact, where the region shrinks to the receiver's own texel. */
-    Region g = {st, r, fmax(1.0 / z_avg - 1.0 / z_p, 0.0)};
+    Region g = {st, r, &st->face[r->mc.face], fmax(1.0 / z_avg - 1.0 / z_p, 0.0)};
     double sum[3] = {0, 0, 0};
     int nodes, level = subdivide(&g, sum, &nodes);
     *tests += nodes * st->taps * st->taps;

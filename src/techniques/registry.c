@@ -101,8 +101,8 @@ void tech_param_range(const ParamDesc *p, char *out, size_t n)
     case PARAM_FLOAT: snprintf(out, n, "[%g, %g]", p->min, p->max); break;
     case PARAM_ENUM: {
         size_t used = (size_t)snprintf(out, n, "one of: ");
-        for (int i = 0; p->choices[i] && used < n; i++)
-            used += (size_t)snprintf(out + used, n - used, "%s%s", i ? ", " : "", p->choices[i]);
+        for (int i = (int)p->min; i <= (int)p->max && p->choices[i] && used < n; i++) /* a technique may accept a prefix */
+            used += (size_t)snprintf(out + used, n - used, "%s%s", i > (int)p->min ? ", " : "", p->choices[i]);
         break;
     }
     }
@@ -140,6 +140,8 @@ bool tech_param_set(const Technique *t, const char *name, double v, double *valu
     const ParamDesc *p = &t->params[i];
     char text[64];
     snprintf(text, sizeof text, "%.9g", v);
+    for (int c = 0; p->type == PARAM_ENUM && c <= v && p->choices[c]; c++) /* a name outside the declared prefix */
+        if (v == c) snprintf(text, sizeof text, "%s", p->choices[c]);
     bool integral = p->type != PARAM_FLOAT;
     if (!isfinite(v) || (integral && v != floor(v)) || v < p->min || v > p->max) return refuse(t, p, text, err);
     values[i] = v;

@@ -2,7 +2,8 @@
  * suite found (issue 7): raw parameter values handed to lab_render, light
  * images with NaN/Inf/negative texels, and procedural geometry past the
  * scene's triangle budget are refused with a message naming what is wrong,
- * before any computation. */
+ * before any computation; in-range parameter values work alone (cascades
+ * at the default fit), or the declared range is what the technique accepts. */
 #include <math.h>
 #include <string.h>
 #include "fixtures.h"
@@ -93,4 +94,61 @@ TEST(test_scene_refuses_geometry_past_the_triangle_budget)
     if (ok) scene_free(&sc);
     CHECK_MSG(!ok, "accepted 16.8M triangles");
     CHECK_MSG(strstr(err.msg, "objects[5]") && strstr(err.msg, "16777216"), "%s", err.msg);
+}
+
+/* cascades = 2 with every other parameter at its default (fit = scene) was
+ * refused; each slice is now fitted to its part of the intersection body B,
+ * the same maps as fit = body. */
+TEST(test_cascades_work_at_the_default_fit)
+{
+    Lab *lab = fixture_lab("c.lua", "return { camera = { position = {0, 2, 4}, target = {0, 0, 0}, width = 32, height = 24 },\n"
+                                    "  lights = { { type = 'directional', direction = {0.3, -1, 0.2} } },\n"
+                                    "  objects = { { shape = 'plane' }, { shape = 'box', translate = {0, 0.5, 0} } } }\n");
+    CHECK(lab);
+    Error err;
+    const Technique *t = tech_find("sm", &err);
+    CHECK(t);
+    Image img[2];
+    const char *fits[2] = {"fit=scene", "fit=body"};
+    for (int k = 0; k < 2; k++) {
+        double v[TECH_MAX_PARAMS];
+        tech_params_default(t, v);
+        CHECK(tech_param_parse(t, "cascades=2", v, &err) && tech_param_parse(t, "map_size=128", v, &err));
+        CHECK(tech_param_parse(t, fits[k], v, &err));
+        RenderRequest req = {t, v, 0, 1};
+        RenderResult out;
+        CHECK_MSG(lab_render(lab, &req, &out, &err), "cascades=2 %s refused: %s", fits[k], err.msg);
+        img[k] = out.visibility;
+        out.visibility = (Image){0};
+        render_result_free(&out);
+    }
+    CHECK(image_count(&img[0]) == image_count(&img[1]));
+    CHECK_MSG(!memcmp(img[0].data, img[1].data, sizeof(float) * image_count(&img[0])),
+              "fit=scene and fit=body differ with cascades");
+    image_free(&img[0]);
+    image_free(&img[1]);
+    lab_close(lab);
+}
+
+/* adaptive_area needs one plain perspective map: its declared ranges of the
+ * shared map parameters say so (cascades [1, 1], projection auto or
+ * perspective, no face split), so the refusal comes when the value is set,
+ * naming the parameter and what it accepts, not from inside a render. */
+TEST(test_adaptive_area_declares_the_map_it_accepts)
+{
+    Error err;
+    const Technique *t = tech_find("adaptive_area", &err);
+    CHECK(t);
+    double v[TECH_MAX_PARAMS];
+    tech_params_default(t, v);
+    /* assignment, what the refusal must say, what it must not list */
+    static const char *const refused[][3] = {{"cascades=2", "cascades", "[1, 16]"},
+                                             {"projection=ortho", "one of: auto, perspective", "perspective, ortho"},
+                                             {"split_scheme=faces", "one of: practical, log, uniform", "uniform, faces"}};
+    for (int i = 0; i < 3; i++) {
+        CHECK_MSG(!tech_param_parse(t, refused[i][0], v, &err), "%s accepted", refused[i][0]);
+        CHECK_MSG(strstr(err.msg, refused[i][1]) && !strstr(err.msg, refused[i][2]), "%s", err.msg);
+    }
+    CHECK_MSG(!tech_param_parse(t, "cascades=2", v, &err) && strstr(err.msg, "[1, 1]"), "%s", err.msg);
+    CHECK(tech_param_parse(t, "cascades=1", v, &err) && tech_param_parse(t, "projection=perspective", v, &err));
 }
