@@ -11,10 +11,12 @@
 struct Lab {
     Scene scene;
     ResourceManager *rm;
+    bool owns_rm;
     double load_s;
 };
 
-Lab *lab_open(const char *scene_path, const char *const *overrides, int num_overrides, Error *err)
+Lab *lab_open_shared(const char *scene_path, const char *const *overrides, int num_overrides, ResourceManager *rm,
+                     Error *err)
 {
     Lab *lab = calloc(1, sizeof *lab);
     if (!lab) { error_set(err, "out of memory"); return NULL; }
@@ -24,7 +26,8 @@ Lab *lab_open(const char *scene_path, const char *const *overrides, int num_over
         return NULL;
     }
     lab->load_s = timer_now_s() - t0;
-    lab->rm = rm_create();
+    lab->owns_rm = rm == NULL;
+    lab->rm = rm ? rm : rm_create();
     if (!lab->rm) {
         lab_close(lab);
         error_set(err, "out of memory");
@@ -33,10 +36,15 @@ Lab *lab_open(const char *scene_path, const char *const *overrides, int num_over
     return lab;
 }
 
+Lab *lab_open(const char *scene_path, const char *const *overrides, int num_overrides, Error *err)
+{
+    return lab_open_shared(scene_path, overrides, num_overrides, NULL, err);
+}
+
 void lab_close(Lab *lab)
 {
     if (!lab) return;
-    rm_destroy(lab->rm);
+    if (lab->owns_rm) rm_destroy(lab->rm);
     scene_free(&lab->scene);
     free(lab);
 }

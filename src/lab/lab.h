@@ -12,6 +12,12 @@
 typedef struct Lab Lab;
 
 Lab *lab_open(const char *scene_path, const char *const *overrides, int num_overrides, Error *err);
+/* The same on a resource manager shared by several labs (the caller keeps it
+ * alive longer than them): resources are keyed by content, so variants of a
+ * scene (a light radius, a camera) reuse the BVH, view samples, maps and
+ * references their keys say they share. NULL: the lab makes its own. */
+Lab *lab_open_shared(const char *scene_path, const char *const *overrides, int num_overrides, ResourceManager *rm,
+                     Error *err);
 void lab_close(Lab *lab);
 const Scene *lab_scene(const Lab *lab);
 ResourceManager *lab_resources(Lab *lab);

@@ -192,14 +192,32 @@ static LightViewParams relevant_params(const ShadowMapSpec *s)
     return v;
 }
 
+/* What of the light a map depends on: the frame it is rendered from (kind,
+ * centre, axis, cone), not its size or colour, so a sweep over the light's
+ * radius reuses the map. Fitting to the view reads the sample classes,
+ * which do depend on the size: then the whole light counts. */
+static void hash_light_frame(Hasher *h, const Scene *sc, int light_index, bool follows_camera)
+{
+    if (follows_camera) {
+        hash_u64(h, sc->hash_lights[light_index]);
+        return;
+    }
+    const Light *l = &sc->lights[light_index];
+    hash_u64(h, (uint64_t)l->kind);
+    hash_f32(h, l->position.x); hash_f32(h, l->position.y); hash_f32(h, l->position.z);
+    hash_f32(h, l->direction.x); hash_f32(h, l->direction.y); hash_f32(h, l->direction.z);
+    hash_f32(h, l->cone_half_rad);
+}
+
 static uint64_t map_key(const Scene *sc, int light_index, const ShadowMapSpec *s)
 {
     Hasher h;
     hash_init(&h);
     hash_u64(&h, sc->hash_casters);                 /* what is drawn */
     hash_u64(&h, sc->hash_geometry);                /* the bounds it is fitted to */
-    hash_u64(&h, sc->hash_lights[light_index]);
-    if (lightview_follows_camera(s->projection, s->fit, &s->view)) hash_u64(&h, sc->hash_camera);
+    bool follows_camera = lightview_follows_camera(s->projection, s->fit, &s->view);
+    hash_light_frame(&h, sc, light_index, follows_camera);
+    if (follows_camera) hash_u64(&h, sc->hash_camera);
     const int64_t fields[] = {s->res, s->projection, s->fit, s->depth, s->depth_bits, s->layer,
                               s->cull, s->triangle_ids, s->conservative};
     for (size_t i = 0; i < sizeof fields / sizeof fields[0]; i++) hash_u64(&h, (uint64_t)fields[i]);

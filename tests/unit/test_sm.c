@@ -288,3 +288,35 @@ TEST(test_pcf_against_the_reference_small_and_large_light)
     lab_close(small);
     lab_close(large);
 }
+
+/* Two variants of a scene on one resource manager: the light's radius does
+ * not change what a shadow map depends on, so the second variant reuses the
+ * BVH, the view samples and the map, and builds only its own sample classes. */
+TEST(test_sm_light_radius_variants_share_the_map)
+{
+    ResourceManager *rm = rm_create();
+    const char *small[] = {"lights[1].radius=0.1"}, *large[] = {"lights[1].radius=0.7"};
+    Error err;
+    Lab *a = lab_open_shared(SCENES "sphere-on-plane.lua", small, 1, rm, &err);
+    Lab *b = a ? lab_open_shared(SCENES "sphere-on-plane.lua", large, 1, rm, &err) : NULL;
+    CHECK_MSG(rm && a && b, "%s", err.msg);
+    RenderResult r;
+    const char *p[] = {"map_size=512"};
+    CHECK(render(a, "sm", p, 1, &r));
+    render_result_free(&r);
+    rm_log_reset(rm);
+    CHECK(render(b, "sm", p, 1, &r));
+    render_result_free(&r);
+    int built = 0;
+    for (int i = 0; i < rm_log_count(rm); i++) {
+        const ResourceEvent *ev = rm_log_event(rm, i);
+        printf("    %s %s\n", ev->built ? "built " : "reused", ev->kind);
+        built += ev->built;
+        CHECK_MSG(ev->built == (strcmp(ev->kind, "sample_classes") == 0), "%s %s", ev->kind,
+                  ev->built ? "rebuilt" : "reused");
+    }
+    CHECK(built == 1);
+    lab_close(a);
+    lab_close(b);
+    rm_destroy(rm);
+}
