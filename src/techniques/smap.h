@@ -24,12 +24,12 @@ extern const char *const smap_select_names[];
 /* The same for a technique that accepts only the projections up to
  * `proj_max`, at most `cascades_max` maps and the split schemes up to
  * `split_max`: its declared ranges are then what it accepts, so every
- * front end and the stability suite see the limit (adaptive_area: one plain
- * perspective map). */
+ * front end and the stability suite see the limit (adaptive_area: plain
+ * perspective maps). */
 #define SMAP_MAP_PARAMS_UPTO(proj_max, cascades_max, split_max)                                                    \
     {"map_size", PARAM_INT, 1024, 1, RASTER_MAX_SIZE, "texels",                                                     \
      "shadow-map resolution per side (per face for cube and paraboloid maps)", NULL},                              \
-    {"projection", PARAM_ENUM, 0, 0, proj_max, "",                                                         \
+    {"projection", PARAM_ENUM, 0, 0, proj_max, "",                                                                  \
      "light projection (course §2.1.1): auto = perspective for spot, rect and disk lights, ortho for directional, " \
      "perspective or a cube map for point and sphere lights (cube when the scene spans more than 150 degrees); "   \
      "or a warp (course §3.2.2) on the ortho or perspective base: psm (Stamminger & Drettakis), lispsm (Wimmer), " \
@@ -66,11 +66,11 @@ extern const char *const smap_select_names[];
      "uniform maps of directional lights: world-fixed orientation and texel-snapped extents on a ladder of "       \
      "sizes, so texels stay still as the camera moves (course §3.2.1); no effect on other maps",                   \
      NULL},                                                                                                        \
-    {"cascades", PARAM_INT, 1, 1, cascades_max, "maps",                                                    \
+    {"cascades", PARAM_INT, 1, 1, cascades_max, "maps",                                                             \
      "z-partitioning (cascaded / parallel-split shadow maps, course §3.2.3.1): this many maps of map_size^2, "      \
      "each fitted to its slice of the intersection body (its visible samples with fit=view); 1: a single map",     \
      NULL},                                                                                                        \
-    {"split_scheme", PARAM_ENUM, 0, 0, split_max, "",                                                                        \
+    {"split_scheme", PARAM_ENUM, 0, 0, split_max, "",                                                               \
      "split positions: practical (lambda log + (1 - lambda) uniform, Zhang 2006), log (C_i = z_n (z_f/z_n)^(i/m), " \
      "Lloyd 2006), uniform, or faces (one warped map per light-facing face of the view frustum, course §3.2.3.2)", \
      smap_split_names},                                                                                            \
