@@ -83,9 +83,11 @@ function Experiment:scene(path, variants)
 end
 
 -- exp:add("pcf", sweep.grid{K = {1, 3, 5}}): a technique at each point (nil:
--- its defaults). Names and ranges are checked now, against the registry.
+-- its defaults; one table of parameters: that single point). Names and
+-- ranges are checked now, against the registry.
 function Experiment:add(technique, points)
   local desc = sl.technique(technique)
+  if points and #points == 0 and next(points) ~= nil then points = { points } end
   for _, p in ipairs(points or { {} }) do
     local ok, full = pcall(sl.params, technique, p)
     if not ok then error(full, 2) end
@@ -202,18 +204,22 @@ local function point_label(entry)
 end
 
 -- Open every variant's Lab and list the configurations in a fixed order
--- (variants, then techniques, then points). A technique is left out of a
--- variant whose light it does not handle (the registry says which); a
--- configuration listed twice (same key: a point equal to the defaults, a
+-- (techniques and their points, then variants): the Labs share one resource
+-- manager, so a technique's points over every variant reuse what their keys
+-- share (a light-radius sweep renders one shadow map). A technique is left
+-- out of a variant whose light it does not handle (the registry says which);
+-- a configuration listed twice (same key: a point equal to the defaults, a
 -- repeated value) runs once.
 function Experiment:configurations()
   local configs, seen = {}, {}
-  for vi, v in ipairs(self.variants) do
+  for _, v in ipairs(self.variants) do
     v.lab = v.lab or sl.open(v.file, v.overrides)
     v.info = v.lab:info()
-    local light = v.info.lights[self.light]
-    if not light then error(string.format("%s has no light %d", v.file, self.light), 0) end
-    for _, e in ipairs(self.entries) do
+    if not v.info.lights[self.light] then error(string.format("%s has no light %d", v.file, self.light), 0) end
+  end
+  for _, e in ipairs(self.entries) do
+    for vi, v in ipairs(self.variants) do
+      local light = v.info.lights[self.light]
       local key = technique_handles(e.technique, light.type) and v.lab:key(e.technique.name, e.params, self.light)
       if key and not seen[key] then
         seen[key] = true
@@ -370,10 +376,10 @@ function Experiment:run(argv)
   for _, c in ipairs(configs) do
     if c.index % o.shard.count == o.shard.index then mine[#mine + 1] = c end
   end
-  local last_use, last_of_entry = {}, {}
+  local last_use, last_of_technique = {}, {}
   for i, c in ipairs(mine) do
     last_use[c.variant] = i
-    last_of_entry[c.variant_index .. "/" .. c.entry.technique.name] = i
+    last_of_technique[c.entry.technique.name] = i
   end
   for i, c in ipairs(mine) do
     local row = writer.done[c.key]
@@ -388,11 +394,12 @@ function Experiment:run(argv)
     end
     if row.status ~= "ok" then result.failed = result.failed + 1 end
     result.rows[#result.rows + 1] = row
+    if last_of_technique[c.entry.technique.name] == i then
+      c.variant.lab:drop_resources() -- the next technique shares little: memory stays bounded
+    end
     if last_use[c.variant] == i then
       c.variant.lab:close()
       c.variant.lab = nil
-    elseif last_of_entry[c.variant_index .. "/" .. c.entry.technique.name] == i then
-      c.variant.lab:drop_resources() -- the next technique shares little: memory stays bounded
     end
   end
   writer:close()

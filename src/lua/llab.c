@@ -1,6 +1,8 @@
-/* llab.c -- the Lab userdata: sl.open(scene, overrides) loads a scene once
- * and keeps its resource manager, so the renders, references and comparisons
- * of a sweep reuse what earlier ones built. Methods mirror the CLI commands
+/* llab.c -- the Lab userdata: sl.open(scene, overrides) loads a scene once.
+ * Every Lab of a Lua state shares one resource manager (resources are keyed
+ * by content), so the renders, references and comparisons of a sweep reuse
+ * what earlier ones built, across scene variants too: a light-radius sweep
+ * renders its shadow map once. Methods mirror the CLI commands
  * (render, reference, compare) with the same options as a table; unknown
  * options and out-of-range values raise errors naming them. Closed by
  * lab:close(), a to-be-closed variable, or the garbage collector. */
@@ -24,6 +26,41 @@ Lab *sl_check_lab(lua_State *L, int idx)
 }
 
 static Lab *check_lab(lua_State *L) { return sl_check_lab(L, 1); }
+
+/* ---- the state's resource manager ----------------------------------------- */
+
+#define SL_RM_TYPE "shadowlab.ResourceManager"
+typedef struct LuaRm { ResourceManager *rm; } LuaRm;
+
+static int rm_gc(lua_State *L)
+{
+    LuaRm *r = luaL_checkudata(L, 1, SL_RM_TYPE);
+    rm_destroy(r->rm);
+    r->rm = NULL;
+    return 0;
+}
+
+/* Push the state's manager, making it on first use. It is marked for
+ * finalisation before any Lab that uses it, so Lua finalises it after them
+ * (reverse order of marking); each Lab also holds it as its user value. */
+static ResourceManager *push_state_rm(lua_State *L)
+{
+    if (lua_getfield(L, LUA_REGISTRYINDEX, SL_RM_TYPE) == LUA_TUSERDATA)
+        return ((LuaRm *)lua_touserdata(L, -1))->rm;
+    lua_pop(L, 1);
+    LuaRm *r = lua_newuserdatauv(L, sizeof *r, 0);
+    r->rm = NULL;
+    if (luaL_newmetatable(L, SL_RM_TYPE)) {
+        lua_pushcfunction(L, rm_gc);
+        lua_setfield(L, -2, "__gc");
+    }
+    lua_setmetatable(L, -2);
+    r->rm = rm_create();
+    if (!r->rm) luaL_error(L, "out of memory");
+    lua_pushvalue(L, -1);
+    lua_setfield(L, LUA_REGISTRYINDEX, SL_RM_TYPE);
+    return r->rm;
+}
 
 /* ---- sl.open ------------------------------------------------------------ */
 
@@ -113,11 +150,14 @@ int sl_lab_open(lua_State *L)
     const char *path = luaL_checkstring(L, 1);
     const char *overrides[MAX_OVERRIDES];
     int n = collect_overrides(L, 2, overrides, MAX_OVERRIDES);
-    LuaLab *ll = lua_newuserdatauv(L, sizeof *ll, 0);
+    ResourceManager *rm = push_state_rm(L);
+    LuaLab *ll = lua_newuserdatauv(L, sizeof *ll, 1);
     ll->lab = NULL;
     luaL_setmetatable(L, SL_LAB_TYPE);
+    lua_rotate(L, -2, 1); /* lab, rm */
+    lua_setiuservalue(L, -2, 1);
     Error err;
-    ll->lab = lab_open(path, overrides, n, &err);
+    ll->lab = lab_open_shared(path, overrides, n, rm, &err);
     if (!ll->lab) sl_raise(L, &err);
     return 1;
 }
@@ -359,7 +399,8 @@ static int lab_info_m(lua_State *L)
     return 1;
 }
 
-/* lab:drop_resources(): free everything the Lab built (the scene stays). */
+/* lab:drop_resources(): free every resource the state's Labs hold (their
+ * scenes stay): what comes next shares nothing with what was built. */
 static int lab_drop_m(lua_State *L)
 {
     rm_clear(lab_resources(check_lab(L)));
