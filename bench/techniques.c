@@ -3,8 +3,7 @@
  * no edit here:
  *   growth: frame time (its resources' build times + set-up + the median
  *     evaluation, lab.h) and evaluation time against its main parameter
- *     (main_param: its first own int, else its first own parameter if a
- *     float), against map_size where it has one,
+ *     (the one it declares in the registry), against map_size where it has one,
  *     against triangle count (the scene's objects[2].segments) and against
  *     image size (camera.width x camera.height at 4:3);
  *   constant: techniques with a summed-area-table prefilter (a `prefilter`
@@ -104,16 +103,8 @@ static bool measure(Lab *lab, const Technique *t, const double *params, int repe
 
 /* ---- growth ---------------------------------------------------------------- */
 
-/* The main knob among the technique's own parameters (after the shared map
- * block): the first int (a kernel, a tap count, a level), else the first
- * parameter when it is a float (a scale); none when an enum leads. */
-static int main_param(const Technique *t)
-{
-    int first = smap_has_map_params(t) ? SMAP_NUM_PARAMS : 0;
-    for (int i = first; i < t->num_params; i++)
-        if (t->params[i].type == PARAM_INT) return i;
-    return first < t->num_params && t->params[first].type == PARAM_FLOAT ? first : -1;
-}
+/* The main knob the technique declares in the registry (-1: none). */
+static int main_param(const Technique *t) { return t->main_param ? tech_param_index(t, t->main_param) : -1; }
 
 /* Values of a parameter: its default times 1/4 ... 8, clamped to its range,
  * without repeats (ints rounded, odd where the default is: kernel widths). */

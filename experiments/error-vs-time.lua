@@ -4,8 +4,9 @@
 -- and the Stanford bunny, against the Embree reference: error against frame
 -- time, with the Pareto front of each scene marked.
 --   build/shadowlab run experiments/error-vs-time.lua [--resume] [--shard I/N] ...
--- The main parameter is a technique's first int or float parameter (the
--- registry lists the main knob first), unless MAIN below names another; it
+-- The main parameter is the one each technique declares in the registry
+-- (`main parameter` in shadowlab list: K, layers, terms, map size...), unless
+-- MAIN below names another; it
 -- is swept over 1/2, 1 and 2 times its default (--factors), within its range. Images
 -- are 240x180 (--set camera.width=W --set camera.height=H for others) and
 -- the reference takes 256 light samples: a few minutes on 2 cores, the
@@ -14,7 +15,7 @@ local sl = require "shadowlab"
 local experiment = require "shadowlab.experiment"
 local report = require "shadowlab.report"
 
-local MAIN = {} -- e.g. MAIN.pcf = "K" to sweep the kernel instead of the map size
+local MAIN = {} -- e.g. MAIN.pcf = "map_size" to sweep the map instead of the kernel
 local args = experiment.parse_args(arg, { factors = { default = "0.5,1,2",
                                                       help = "multiples of each main parameter's default" } })
 local FACTORS = {}
@@ -23,10 +24,9 @@ for f in args.extra.factors:gmatch("[^,]+") do
 end
 
 local function main_parameter(t)
+  local name = MAIN[t.name] or t.main
   for _, p in ipairs(t.params) do
-    if (MAIN[t.name] and p.name == MAIN[t.name]) or (not MAIN[t.name] and (p.type == "int" or p.type == "float")) then
-      return p
-    end
+    if p.name == name then return p end
   end
 end
 

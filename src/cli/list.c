@@ -10,7 +10,8 @@ static void print_text(void)
         const Technique *t = tech_at(i);
         char lights[160];
         tech_lights_text(t, lights, sizeof lights);
-        printf("%s  [%s; %s]\n  %s\n  lights: %s\n", t->name, t->family, t->source, t->summary, lights);
+        printf("%s  [%s; %s]\n  %s\n  lights: %s\n  main parameter: %s\n", t->name, t->family, t->source, t->summary,
+               lights, t->main_param ? t->main_param : "none");
         printf("  resources:");
         for (const char *const *r = t->resources; *r; r++) printf(" %s", *r);
         printf("\n");
@@ -35,8 +36,10 @@ static void print_markdown(void)
         const Technique *t = tech_at(i);
         char lights[160];
         tech_lights_text(t, lights, sizeof lights);
-        printf("\n## `%s`\n\n%s\n\n- family: %s\n- source: %s\n- lights: %s\n- output: %s\n- resources:", t->name,
-               t->summary, t->family, t->source, lights, t->rgb ? "visibility, RGB for textured lights" : "visibility");
+        printf("\n## `%s`\n\n%s\n\n- family: %s\n- source: %s\n- lights: %s\n- main parameter: %s\n- output: %s\n"
+               "- resources:",
+               t->name, t->summary, t->family, t->source, lights, t->main_param ? t->main_param : "none",
+               t->rgb ? "visibility, RGB for textured lights" : "visibility");
         for (const char *const *r = t->resources; *r; r++) printf(" `%s`", *r);
         printf("\n\n| parameter | type | default | range | unit | meaning |\n|---|---|---|---|---|---|\n");
         for (int k = 0; k < t->num_params; k++) {
@@ -62,6 +65,7 @@ static void print_json(void)
         json_string(&w, "source", t->source);
         json_string(&w, "summary", t->summary);
         json_bool(&w, "rgb", t->rgb);
+        if (t->main_param) json_string(&w, "main_param", t->main_param); /* absent: none */
         json_array_begin(&w, "lights");
         for (int k = LIGHT_POINT; k <= LIGHT_TEXTURED_RECT; k++)
             if (t->lights & LIGHT_BIT(k)) json_string(&w, NULL, light_kind_name((LightKind)k));

@@ -66,6 +66,10 @@ void sl_push_technique(lua_State *L, const Technique *t)
     }
     lua_pushboolean(L, t->rgb);
     lua_setfield(L, -2, "rgb");
+    if (t->main_param) {
+        lua_pushstring(L, t->main_param);
+        lua_setfield(L, -2, "main"); /* nil when the technique declares none */
+    }
     lua_newtable(L);
     for (int k = LIGHT_POINT, n = 0; k <= LIGHT_TEXTURED_RECT; k++)
         if (t->lights & LIGHT_BIT(k)) {

@@ -212,6 +212,7 @@ const Technique tech_accumulation = {
     .resources = acc_resources,
     .rgb = false,
     .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),
+    .main_param = "K",
     .prepare = acc_prepare,
     .evaluate = acc_evaluate,
     .release = free,

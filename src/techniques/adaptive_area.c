@@ -325,6 +325,7 @@ const Technique tech_adaptive_area = {
     .resources = aa_resources,
     .rgb = true,
     .lights = LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_TEXTURED_RECT),
+    .main_param = "threshold",
     .prepare = aa_prepare,
     .evaluate = aa_evaluate,
     .release = free,

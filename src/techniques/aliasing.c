@@ -77,6 +77,7 @@ const Technique tech_aliasing = {
     .resources = aliasing_resources,
     .rgb = false,
     .lights = LIGHTS_ALL,
+    .main_param = "map_size",
     .prepare = aliasing_prepare,
     .evaluate = aliasing_evaluate,
     .release = free,

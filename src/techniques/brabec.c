@@ -239,6 +239,7 @@ const Technique tech_brabec = {
     .resources = brabec_resources,
     .rgb = false,
     .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),
+    .main_param = "search_radius",
     .prepare = brabec_prepare,
     .evaluate = brabec_evaluate,
     .release = brabec_release,

@@ -94,6 +94,7 @@ const Technique tech_csm = {
     .resources = filter_resources,
     .rgb = false,
     .lights = LIGHTS_ALL,
+    .main_param = "terms",
     .prepare = csm_prepare,
     .evaluate = csm_evaluate,
     .release = free,

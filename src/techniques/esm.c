@@ -137,6 +137,7 @@ const Technique tech_esm = {
     .resources = esm_resources,
     .rgb = false,
     .lights = LIGHTS_ALL,
+    .main_param = "K",
     .prepare = esm_prepare,
     .evaluate = esm_evaluate,
     .release = free,

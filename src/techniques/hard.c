@@ -64,6 +64,7 @@ const Technique tech_hard = {
     .resources = hard_resources,
     .rgb = true,
     .lights = LIGHTS_ALL,
+    .main_param = NULL,
     .prepare = hard_prepare,
     .evaluate = hard_evaluate,
     .release = free,

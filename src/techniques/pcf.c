@@ -182,6 +182,7 @@ const Technique tech_pcf = {
     .resources = pcf_resources,
     .rgb = false,
     .lights = LIGHTS_ALL,
+    .main_param = "K",
     .prepare = pcf_prepare,
     .evaluate = pcf_evaluate,
     .release = free,

@@ -217,6 +217,7 @@ const Technique tech_pcss = {
     .resources = pcss_resources,
     .rgb = false,
     .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),
+    .main_param = "filter_taps",
     .prepare = pcss_prepare,
     .evaluate = pcss_evaluate,
     .release = free,

@@ -147,6 +147,7 @@ const Technique tech_shadow_width = {
     .resources = sw_resources,
     .rgb = false,
     .lights = LIGHTS_ALL,
+    .main_param = "c_scale",
     .prepare = sw_prepare,
     .evaluate = sw_evaluate,
     .release = free,

@@ -151,6 +151,7 @@ const Technique tech_single_sample_rt = {
     .resources = ss_resources,
     .rgb = false,
     .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),
+    .main_param = NULL,
     .prepare = ss_prepare,
     .evaluate = ss_evaluate,
     .release = free,

@@ -98,6 +98,7 @@ const Technique tech_sm = {
     .resources = sm_resources,
     .rgb = false,
     .lights = LIGHTS_ALL,
+    .main_param = "map_size",
     .prepare = sm_prepare,
     .evaluate = sm_evaluate,
     .release = free,

@@ -56,6 +56,7 @@ typedef struct Technique {
     const char *const *resources;/* resource kinds it may acquire, NULL-terminated */
     bool rgb;                    /* evaluates 3 channels when ctx->channels == 3 */
     unsigned lights;             /* LIGHT_BIT set of the light kinds it handles; others are refused */
+    const char *main_param;      /* the knob sweeps vary first (a kernel, layers, terms); NULL: none */
     /* Acquire resources and build per-run state (may be NULL on success). */
     bool (*prepare)(const TechContext *ctx, void **state, Error *err);
     /* Visibility of samples [begin, end) into out[(s - begin) * channels + c];

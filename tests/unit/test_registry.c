@@ -14,6 +14,8 @@ TEST(test_registry_declarations_are_complete)
         CHECK_MSG(t->prepare && t->evaluate, "%s: no prepare/evaluate", t->name);
         CHECK(t->num_params <= TECH_MAX_PARAMS);
         CHECK_MSG(t->lights != 0 && (t->lights & ~LIGHTS_ALL) == 0, "%s: light kinds %#x", t->name, t->lights);
+        CHECK_MSG(!t->main_param || tech_param_index(t, t->main_param) >= 0, "%s: main parameter %s is not one of its own",
+                  t->name, t->main_param);
         Error err;
         CHECK_MSG(tech_find(t->name, &err) == t, "%s is not found by name", t->name);
         for (int j = 0; j < i; j++) CHECK_MSG(strcmp(tech_at(j)->name, t->name) != 0, "duplicate %s", t->name);
