@@ -111,6 +111,8 @@ static void list_cases(void)
     for (int i = 0; i < stab_case_count(); i++) printf("%-34s %s\n", stab_case_name(i), stab_case_doc(i));
     printf("%-34s %s\n", "param_NAME", "--quick: every probe below of the parameter in one row");
     printf("%-34s %s\n", "param_NAME_{min,min_plus_1,max}", "each parameter at its bounds: finite output in [0,1]");
+    printf("%-34s %s\n", "param_NAME_at_{42,44.36,88.72}",
+           "floats whose range holds float32's exponential limits (EVSM 42, exp(2c), exp(c)): finite output");
     printf("%-34s %s\n", "param_NAME_{below_min,above_max}", "just outside: refused naming the parameter and its range");
     printf("%-34s %s\n", "param_NAME_nonfinite", "NaN and +-Inf refused, also when handed raw to lab_render");
 }

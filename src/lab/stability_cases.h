@@ -76,6 +76,7 @@ typedef struct StabCase {
 typedef enum ParamProbe {
     PROBE_NONE,
     PROBE_AT_MIN, PROBE_MIN_PLUS_ONE, PROBE_AT_MAX, /* render at the value */
+    PROBE_FP32_EVSM, PROBE_FP32_EXP2, PROBE_FP32_EXP, /* floats: render at float32's exponential limits */
     PROBE_BELOW_MIN, PROBE_ABOVE_MAX,                /* refused naming the parameter and its range */
     PROBE_NONFINITE,                                 /* NaN and +-Inf refused, also raw in lab_render */
     PROBE_ALL,                                       /* quick runs: every probe above in one run */

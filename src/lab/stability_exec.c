@@ -5,6 +5,7 @@
  * the lit candidates, measure the error against the cheap reference and
  * check the case's limit; or check that bad input is refused with a message
  * naming what is wrong. */
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <omp.h>
@@ -38,14 +39,28 @@ static void note(StabResult *r, const char *fmt, ...)
 
 const char *stab_probe_suffix(ParamProbe probe)
 {
-    static const char *const names[PROBE_COUNT] = {"", "min", "min_plus_1", "max", "below_min", "above_max",
-                                                   "nonfinite", "all"};
+    static const char *const names[PROBE_COUNT] = {"", "min", "min_plus_1", "max", "at_42", "at_44.36", "at_88.72",
+                                                   "below_min", "above_max", "nonfinite", "all"};
     return names[probe];
 }
+
+/* Float32's exponential limits (course §4.2.4, catalogue [OWN]; issue 7):
+ * exp(c z) overflows above c = ln(FLT_MAX) = 88.72 (ESM), the second moment
+ * exp(2 c z) above 44.36 (EVSM), whose usual limit 42 leaves a margin for
+ * the filter's sums. Every float parameter whose range holds one is
+ * rendered there: a technique must stay finite at any value it accepts. */
+static double fp32_limit(ParamProbe probe)
+{
+    double ln_max = log((double)FLT_MAX);
+    return probe == PROBE_FP32_EVSM ? 42.0 : probe == PROBE_FP32_EXP2 ? 0.5 * ln_max : ln_max;
+}
+
+static bool is_fp32_probe(ParamProbe probe) { return probe >= PROBE_FP32_EVSM && probe <= PROBE_FP32_EXP; }
 
 bool stab_probe_applies(const ParamDesc *p, ParamProbe probe)
 {
     if (probe == PROBE_MIN_PLUS_ONE) return p->type == PARAM_INT && p->max >= p->min + 2;
+    if (is_fp32_probe(probe)) return p->type == PARAM_FLOAT && p->min < fp32_limit(probe) && fp32_limit(probe) < p->max;
     return true;
 }
 
@@ -58,6 +73,9 @@ double stab_probe_value(const ParamDesc *p, ParamProbe probe)
     case PROBE_AT_MIN: return p->min;
     case PROBE_MIN_PLUS_ONE: return p->min + 1.0;
     case PROBE_AT_MAX: return p->max;
+    case PROBE_FP32_EVSM:
+    case PROBE_FP32_EXP2:
+    case PROBE_FP32_EXP: return fp32_limit(probe);
     case PROBE_BELOW_MIN: return p->min - below;
     case PROBE_ABOVE_MAX: return p->max + above;
     default: return NAN;

@@ -20,7 +20,8 @@
 
 typedef enum Misbehaviour {
     OK_HALF, GIVES_NAN, GIVES_1_5, CRASHES, HANGS, OVERFLOWS, LEAKS, REFUSES, ALWAYS_LIT,
-    NAN_UNLESS_CAPPED /* 0.5 while map_res is at most STAB_QUICK_TEXELS, else NaN */
+    NAN_UNLESS_CAPPED, /* 0.5 while map_res is at most STAB_QUICK_TEXELS, else NaN */
+    NAN_NEAR_88        /* 0.5, but NaN while gain is in (80, 90): exp overflowing float32 */
 } Misbehaviour;
 
 static Misbehaviour current;
@@ -44,10 +45,11 @@ static void fake_evaluate(const void *state, const TechContext *ctx, int begin, 
 {
     (void)state;
     static const float values[] = {[OK_HALF] = 0.5f, [GIVES_1_5] = 1.5f, [ALWAYS_LIT] = 1.0f,
-                                   [NAN_UNLESS_CAPPED] = 0.5f};
-    bool capped = ctx->params[2] <= STAB_QUICK_TEXELS;
+                                   [NAN_UNLESS_CAPPED] = 0.5f, [NAN_NEAR_88] = 0.5f};
+    bool capped = ctx->params[2] <= STAB_QUICK_TEXELS, near_88 = ctx->params[3] > 80 && ctx->params[3] < 90;
     for (int s = begin; s < end; s++) {
-        float v = current == GIVES_NAN || (current == NAN_UNLESS_CAPPED && !capped) ? NAN : values[current];
+        bool nan = current == GIVES_NAN || (current == NAN_UNLESS_CAPPED && !capped) || (current == NAN_NEAR_88 && near_88);
+        float v = nan ? NAN : values[current];
         if (current == CRASHES) raise(SIGSEGV);
         if (current == OVERFLOWS) {
             volatile char *p = malloc(8);
@@ -62,13 +64,14 @@ static const ParamDesc fake_params[] = {
     {"weight", PARAM_FLOAT, 0.5, 0.0, 1.0, "", "a float parameter", NULL},
     {"taps", PARAM_INT, 4, 1, 64, "texels", "an int parameter", NULL},
     {"map_res", PARAM_INT, 1024, 1, 4096, "texels", "a map resolution (capped in quick runs)", NULL},
+    {"gain", PARAM_FLOAT, 1, 0, 100, "", "an exponent, probed at float32's limits", NULL},
 };
 static const char *const no_resources[] = {NULL};
 
 static Technique fake(const char *name, unsigned lights)
 {
     return (Technique){.name = name, .family = "test", .source = "selftest", .summary = "misbehaves on purpose",
-                       .params = fake_params, .num_params = 3, .resources = no_resources, .rgb = true,
+                       .params = fake_params, .num_params = 4, .resources = no_resources, .rgb = true,
                        .lights = lights, .prepare = fake_prepare, .evaluate = fake_evaluate, .release = NULL};
 }
 
@@ -159,6 +162,8 @@ static void selftests(void)
     expect("harness_merged_probes_name_the_failing_one", GIVES_NAN, all, "param_weight", STAB_FAIL, "min: ");
     expect("harness_quick_caps_map_sizes", NAN_UNLESS_CAPPED, all, "contact", STAB_PASS, NULL);
     expect("harness_quick_probes_the_cap_itself", NAN_UNLESS_CAPPED, all, "param_map_res", STAB_FAIL, "max: ");
+    expect("harness_probes_float32_exp_limits", NAN_NEAR_88, all, "param_gain_at_88", STAB_FAIL, "non-finite");
+    expect("harness_quick_probes_float32_exp_limits", NAN_NEAR_88, all, "param_gain", STAB_FAIL, "at_88.72: ");
     expect_shared_preparation();
 }
 
