@@ -17,6 +17,7 @@
 #define SUB (1 << RASTER_SUBPIXEL_BITS) /* sub-texel steps per texel */
 #define HALF (SUB / 2)                  /* texel centre offset */
 #define TILE 64                          /* texels per tile side */
+#define CHUNK_TRIANGLES 4096             /* triangles per set-up chunk (at most 4 chunks per thread) */
 /* Triangles ahead whose data is fetched early: a mesh's index order jumps
  * around its vertex array, and a tile's bin around the triangle array. */
 #define PREFETCH_AHEAD 8
@@ -144,7 +145,7 @@ static void transform_vertices(const Setup *s, const RasterMesh *m, Vertices *ou
     const RasterView *v = s->view;
     const double *r = v->depth_row;
     ClipPlanes planes = v->mapping == RASTER_PARABOLOID ? CLIP_FRONT_ONLY : CLIP_FRUSTUM;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 2048)
     for (int i = 0; i < m->num_vertices; i++) {
         dvec3 p = d3_from(m->positions[i]);
         dvec4 c = m4_apply(&v->clip_from_world, p);
@@ -368,15 +369,38 @@ static bool row_span(const Fill *F, int j, int *lo, int *hi)
     return *lo <= *hi;
 }
 
-/* Value of texel k of a span from the row's start, perspective or affine. */
-static inline float span_value(double f_row, double fs, double q_row, double qs, double k, bool perspective)
+/* Value of texel k of a span from the row's start, perspective or affine.
+ * Float lanes: the planes are evaluated in double at the row's start and
+ * stepped in float, one rounding more than the float32 the map stores. */
+static inline float span_value(float f_row, float fs, float q_row, float qs, float k, bool perspective)
 {
-    return perspective ? (float)((f_row + fs * k) / (q_row + qs * k)) : (float)(f_row + fs * k);
+    return perspective ? (f_row + fs * k) / (q_row + qs * k) : f_row + fs * k;
 }
 
-/* Texels [i0, i1] of row j, all inside the triangle. The common case
- * (nearest test, no ids, peeling or clamping) is a branch-free loop the
- * compiler vectorises. */
+/* The common case of a span (nearest test, no ids, peeling or clamping):
+ * a branch-free loop in float lanes, AVX2 where the CPU has it. */
+__attribute__((target_clones("avx2", "default")))
+static int span_nearest(float *d, int n, float f_row, float fs, float q_row, float qs, bool persp)
+{
+    int written = 0;
+    if (persp) { /* two loops: a division under a branch is not if-converted */
+#pragma omp simd reduction(+ : written)
+        for (int i = 0; i < n; i++) {
+            float v = (f_row + fs * (float)i) / (q_row + qs * (float)i), old = d[i];
+            written += v < old;
+            d[i] = v < old ? v : old;
+        }
+        return written;
+    }
+#pragma omp simd reduction(+ : written)
+    for (int i = 0; i < n; i++) {
+        float v = f_row + fs * (float)i, old = d[i];
+        written += v < old;
+        d[i] = v < old ? v : old;
+    }
+    return written;
+}
+
 static long fill_span(const Fill *F, const Target *T, int32_t id, int j, int i0, int i1)
 {
     double py = (double)j * SUB + HALF, px0 = (double)i0 * SUB + HALF;
@@ -387,20 +411,11 @@ static long fill_span(const Fill *F, const Target *T, int32_t id, int j, int i0,
     float *d = T->depth + row;
     int n = i1 - i0 + 1;
     bool persp = T->perspective;
-    if (!T->farthest && !T->id && !T->peel && !T->conservative) {
-        int written = 0;
-#pragma omp simd reduction(+ : written)
-        for (int i = 0; i < n; i++) {
-            float v = span_value(f_row, fs, q_row, qs, i, persp), old = d[i];
-            int pass = v < old;
-            d[i] = pass ? v : old;
-            written += pass;
-        }
-        return written;
-    }
+    if (!T->farthest && !T->id && !T->peel && !T->conservative)
+        return span_nearest(d, n, (float)f_row, (float)fs, (float)q_row, (float)qs, persp);
     long written = 0;
     for (int i = 0; i < n; i++) {
-        float v = span_value(f_row, fs, q_row, qs, i, persp);
+        float v = span_value((float)f_row, (float)fs, (float)q_row, (float)qs, (float)i, persp);
         if (T->conservative) v = v < F->fmin ? F->fmin : v > F->fmax ? F->fmax : v;
         if (T->peel && !(v > T->peel[row + (size_t)i])) continue;
         if (T->farthest ? !(v > d[i]) : !(v < d[i])) continue;
@@ -445,11 +460,13 @@ static long fill_small(const Fill *F, const Target *T, int i0, int j0, int i1, i
         double f_row = F->f0 + F->fx * ((double)px - F->x0) + F->fy * ((double)py - F->y0);
         double q_row = F->q0 + F->qx * ((double)px - F->x0) + F->qy * ((double)py - F->y0);
         float *d = T->depth + (size_t)j * (size_t)T->stride + (size_t)i0;
+        /* affine values divide by 1: one branch-free loop for both kinds */
+        float fr = (float)f_row, fsf = (float)fs, qr = persp ? (float)q_row : 1.0f, qsf = persp ? (float)qs : 0.0f;
         int w = 0;
 #pragma omp simd reduction(+ : w)
         for (int i = 0; i < n; i++) {
             int32_t inside = (e0 + step0 * i) | (e1 + step1 * i) | (e2 + step2 * i); /* >= 0: all three are */
-            float v = span_value(f_row, fs, q_row, qs, i, persp), old = d[i];
+            float v = (fr + fsf * (float)i) / (qr + qsf * (float)i), old = d[i];
             int pass = inside >= 0 && v < old;
             d[i] = pass ? v : old;
             w += pass;
@@ -543,13 +560,13 @@ static bool setup_chunk(const Setup *s, const RasterMesh *meshes, int num_meshes
 }
 
 /* Passes 3 and 4: bins from the per-thread counts, then the tiles. */
-static long bin_and_fill(const Setup *s, ThreadTris *tt, int nthreads, DepthBuffer *db, bool *ok)
+static long bin_and_fill(const Setup *s, ThreadTris *tt, int nchunks, DepthBuffer *db, bool *ok)
 {
     int ntiles = s->tiles_x * s->tiles_y;
     int *bin_start = malloc(sizeof(int) * (size_t)(ntiles + 1));
-    int *cursor = malloc(sizeof(int) * (size_t)ntiles * (size_t)nthreads);
+    int *cursor = malloc(sizeof(int) * (size_t)ntiles * (size_t)nchunks);
     long total = 0;
-    for (int k = 0; k < nthreads; k++)
+    for (int k = 0; k < nchunks; k++)
         for (int i = 0; i < tt[k].count; i++)
             total += (long)(tt[k].tri[i].i1 / TILE - tt[k].tri[i].i0 / TILE + 1) *
                      (tt[k].tri[i].j1 / TILE - tt[k].tri[i].j0 / TILE + 1);
@@ -562,14 +579,14 @@ static long bin_and_fill(const Setup *s, ThreadTris *tt, int nthreads, DepthBuff
     int at = 0;
     for (int tile = 0; tile < ntiles; tile++) { /* tile-major, thread order within a tile */
         bin_start[tile] = at;
-        for (int k = 0; k < nthreads; k++) {
+        for (int k = 0; k < nchunks; k++) {
             cursor[(size_t)k * ntiles + tile] = at;
             at += tt[k].tile_count[tile];
         }
     }
     bin_start[ntiles] = at;
-#pragma omp parallel for schedule(static, 1)
-    for (int k = 0; k < nthreads; k++) {
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int k = 0; k < nchunks; k++) {
         int *cur = cursor + (size_t)k * ntiles;
         for (int i = 0; i < tt[k].count; i++) {
             const SnapTri *t = &tt[k].tri[i];
@@ -606,21 +623,26 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
     if (!check_inputs(meshes, num_meshes, view, opt, db, err)) return false;
     Setup s = {view, opt, value_mode(view, opt), db->width, db->height, (db->width + TILE - 1) / TILE,
                (db->height + TILE - 1) / TILE};
-    int nthreads = omp_get_max_threads();
     long total = 0;
+    for (int m = 0; m < num_meshes; m++) total += meshes[m].num_triangles;
+    /* More chunks than threads, taken dynamically, so a thread the scheduler
+     * takes away on a shared machine holds up no phase for long; chunk
+     * order, not thread order, fixes each tile's triangle order. */
+    int nthreads = omp_get_max_threads();
+    long by_size = total / CHUNK_TRIANGLES + 1;
+    int nchunks = (int)(by_size < 4L * nthreads ? by_size : 4L * nthreads);
     Vertices *cv = calloc((size_t)(num_meshes > 0 ? num_meshes : 1), sizeof *cv);
-    ThreadTris *tt = calloc((size_t)nthreads, sizeof *tt);
+    ThreadTris *tt = calloc((size_t)nchunks, sizeof *tt);
     bool ok = cv && tt;
     for (int m = 0; ok && m < num_meshes; m++) {
-        total += meshes[m].num_triangles;
         size_t nv = (size_t)(meshes[m].num_vertices > 0 ? meshes[m].num_vertices : 1);
         cv[m].v = malloc(sizeof *cv[m].v * nv);
         cv[m].clip = malloc(sizeof *cv[m].clip * nv);
         ok = cv[m].v && cv[m].clip;
         if (ok) transform_vertices(&s, &meshes[m], &cv[m]);
     }
-    long chunk = (total + nthreads - 1) / nthreads;
-    for (int k = 0; ok && k < nthreads; k++) {
+    long chunk = (total + nchunks - 1) / nchunks;
+    for (int k = 0; ok && k < nchunks; k++) {
         /* Room for the whole chunk up front: most triangles survive, and growing copies them all. */
         tt[k].cap = (int)(chunk < INT32_MAX / 2 ? chunk + 16 : INT32_MAX / 2);
         tt[k].tri = malloc(sizeof *tt[k].tri * (size_t)tt[k].cap);
@@ -629,14 +651,14 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
     }
     if (ok) {
         int failed = 0;
-#pragma omp parallel for schedule(static, 1) reduction(+ : failed)
-        for (int k = 0; k < nthreads; k++) failed += !setup_chunk(&s, meshes, num_meshes, cv, k * chunk,
-                                                               (k + 1) * chunk < total ? (k + 1) * chunk : total, &tt[k]);
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : failed)
+        for (int k = 0; k < nchunks; k++) failed += !setup_chunk(&s, meshes, num_meshes, cv, k * chunk,
+                                                              (k + 1) * chunk < total ? (k + 1) * chunk : total, &tt[k]);
         ok = failed == 0;
     }
-    long written = ok ? bin_and_fill(&s, tt, nthreads, db, &ok) : 0;
+    long written = ok ? bin_and_fill(&s, tt, nchunks, db, &ok) : 0;
     RasterStats st = {total, 0, 0, 0, written};
-    for (int k = 0; tt && k < nthreads; k++) {
+    for (int k = 0; tt && k < nchunks; k++) {
         st.triangles_culled += tt[k].culled;
         st.triangles_clipped += tt[k].clipped;
         st.triangles_drawn += tt[k].count;
