@@ -247,7 +247,6 @@ static void plan_param_probes(Runner *rn, const Technique *t)
 typedef struct CaseRun {
     const Runner *rn;
     const StabCase *c;
-    LightKind kind;
     int *members; /* indices into rn->jobs */
     int n;
     char scene_path[1200];
@@ -434,7 +433,7 @@ static void run_planned(Runner *rn)
     bool *done = calloc((size_t)rn->num_jobs + 1, sizeof *done);
     for (int i = 0; members && done && i < rn->num_jobs; i++) {
         if (done[i]) continue;
-        CaseRun cr = {.rn = rn, .c = rn->jobs[i].c, .kind = rn->jobs[i].kind, .members = members, .n = 0};
+        CaseRun cr = {.rn = rn, .c = rn->jobs[i].c, .members = members, .n = 0};
         for (int j = i; j < rn->num_jobs; j++)
             if (!done[j] && same_scene(&rn->jobs[i], &rn->jobs[j])) {
                 members[cr.n++] = j;
