@@ -29,7 +29,8 @@ static Lab *check_lab(lua_State *L) { return sl_check_lab(L, 1); }
 
 /* ---- the state's resource manager ----------------------------------------- */
 
-#define SL_RM_TYPE "shadowlab.ResourceManager"
+#define SL_RM_TYPE "shadowlab.ResourceManager"     /* the metatable's registry name */
+#define SL_RM_STATE "shadowlab.state_resources"   /* the one instance's registry key */
 typedef struct LuaRm { ResourceManager *rm; } LuaRm;
 
 static int rm_gc(lua_State *L)
@@ -45,7 +46,7 @@ static int rm_gc(lua_State *L)
  * (reverse order of marking); each Lab also holds it as its user value. */
 static ResourceManager *push_state_rm(lua_State *L)
 {
-    if (lua_getfield(L, LUA_REGISTRYINDEX, SL_RM_TYPE) == LUA_TUSERDATA)
+    if (lua_getfield(L, LUA_REGISTRYINDEX, SL_RM_STATE) == LUA_TUSERDATA)
         return ((LuaRm *)lua_touserdata(L, -1))->rm;
     lua_pop(L, 1);
     LuaRm *r = lua_newuserdatauv(L, sizeof *r, 0);
@@ -58,7 +59,7 @@ static ResourceManager *push_state_rm(lua_State *L)
     r->rm = rm_create();
     if (!r->rm) luaL_error(L, "out of memory");
     lua_pushvalue(L, -1);
-    lua_setfield(L, LUA_REGISTRYINDEX, SL_RM_TYPE);
+    lua_setfield(L, LUA_REGISTRYINDEX, SL_RM_STATE);
     return r->rm;
 }
 
