@@ -84,6 +84,7 @@ void depth_buffer_free(DepthBuffer *db)
 {
     free(db->depth);
     free(db->triangle);
+    raster_scratch_free(db->scratch);
     memset(db, 0, sizeof *db);
 }
 
@@ -139,6 +140,39 @@ typedef struct Vertices {
     RVertex *v;
     ClipVertex *clip;
 } Vertices;
+
+/* ---- working memory kept between renders (DepthBuffer.scratch) ------------- */
+
+/* A block reused while large enough; its contents do not survive growth. */
+typedef struct Block { void *p; size_t bytes; } Block;
+
+static void *block_reserve(Block *b, size_t bytes)
+{
+    if (bytes <= b->bytes && b->p) return b->p;
+    free(b->p);
+    b->p = malloc(bytes > 0 ? bytes : 1);
+    b->bytes = b->p ? bytes : 0;
+    return b->p;
+}
+
+struct RasterScratch {
+    Block vertices, clip;               /* every mesh's, one after the other */
+    Block tile_counts;                  /* chunks x tiles */
+    Block bin_start, cursor, bins;      /* pass 3 */
+    ThreadTris *chunk;                  /* per set-up chunk; push_tri grows its triangles */
+    int num_chunks;
+};
+
+void raster_scratch_free(RasterScratch *scratch)
+{
+    if (!scratch) return;
+    Block *blocks[] = {&scratch->vertices, &scratch->clip, &scratch->tile_counts, &scratch->bin_start,
+                       &scratch->cursor, &scratch->bins};
+    for (size_t i = 0; i < sizeof blocks / sizeof *blocks; i++) free(blocks[i]->p);
+    for (int k = 0; k < scratch->num_chunks; k++) free(scratch->chunk[k].tri);
+    free(scratch->chunk);
+    free(scratch);
+}
 
 static void transform_vertices(const Setup *s, const RasterMesh *m, Vertices *out)
 {
@@ -329,13 +363,19 @@ static void fill_setup(const SnapTri *t, const RasterOptions *opt, bool perspect
     F->fmax = (float)dmax(v[0], dmax(v[1], v[2]));
 }
 
+/* Where a tile's fragments go: depth into a tile-local buffer (it stays in
+ * L1 while the tile's triangles are drawn, and is written to the map once),
+ * ids and the peeling layer in the map's own rows. */
 typedef struct Target {
-    float *depth;
-    int32_t *id;
+    float *depth;     /* texel (i, j) at (j - tj0) * TILE + (i - ti0) */
+    int ti0, tj0;
+    int32_t *id;      /* texel (i, j) at j * stride + i, as peel */
     const float *peel;
     int stride;
     bool farthest, perspective, conservative;
 } Target;
+
+static inline float *tile_row(const Target *T, int j, int i) { return T->depth + (size_t)(j - T->tj0) * TILE + (i - T->ti0); }
 
 /* floor(n / d) for d > 0 without a 64-bit integer division (tens of cycles,
  * once per edge and row): |n| < 2^47 and d < 2^31 are exact doubles, so the
@@ -408,7 +448,7 @@ static long fill_span(const Fill *F, const Target *T, int32_t id, int j, int i0,
     double q_row = F->q0 + F->qx * (px0 - F->x0) + F->qy * (py - F->y0);
     double fs = F->fx * SUB, qs = F->qx * SUB;
     size_t row = (size_t)j * (size_t)T->stride + (size_t)i0;
-    float *d = T->depth + row;
+    float *d = tile_row(T, j, i0);
     int n = i1 - i0 + 1;
     bool persp = T->perspective;
     if (!T->farthest && !T->id && !T->peel && !T->conservative)
@@ -459,7 +499,7 @@ static long fill_small(const Fill *F, const Target *T, int i0, int j0, int i1, i
         int32_t e2 = (int32_t)(F->a[2] * px + F->b[2] * py + F->c[2]);
         double f_row = F->f0 + F->fx * ((double)px - F->x0) + F->fy * ((double)py - F->y0);
         double q_row = F->q0 + F->qx * ((double)px - F->x0) + F->qy * ((double)py - F->y0);
-        float *d = T->depth + (size_t)j * (size_t)T->stride + (size_t)i0;
+        float *d = tile_row(T, j, i0);
         /* affine values divide by 1: one branch-free loop for both kinds */
         float fr = (float)f_row, fsf = (float)fs, qr = persp ? (float)q_row : 1.0f, qsf = persp ? (float)qs : 0.0f;
         int w = 0;
@@ -496,15 +536,14 @@ static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, cons
     int ti1 = ti0 + TILE - 1 < s->width - 1 ? ti0 + TILE - 1 : s->width - 1;
     int tj1 = tj0 + TILE - 1 < s->height - 1 ? tj0 + TILE - 1 : s->height - 1;
     const RasterOptions *opt = s->opt;
-    Target T = {db->depth, db->triangle, opt->peel, s->width, opt->test == RASTER_FARTHEST,
+    float local[TILE * TILE];
+    Target T = {local, ti0, tj0, db->triangle, opt->peel, s->width, opt->test == RASTER_FARTHEST,
                 s->mode == VALUE_PERSPECTIVE && opt->depth == RASTER_DEPTH_LINEAR, opt->conservative};
     float empty = T.farthest ? -INFINITY : INFINITY;
     bool fast = !T.farthest && !T.id && !T.peel && !T.conservative; /* fill_small's case */
     int n = ti1 - ti0 + 1;
-    for (int j = tj0; j <= tj1; j++) {
-        float *d = db->depth + (size_t)j * s->width + ti0;
-        for (int i = 0; i < n; i++) d[i] = empty;
-        if (!db->triangle) continue;
+    for (int i = 0; i < TILE * TILE; i++) local[i] = empty;
+    for (int j = tj0; db->triangle && j <= tj1; j++) {
         int32_t *id = db->triangle + (size_t)j * s->width + ti0;
         for (int i = 0; i < n; i++) id[i] = -1;
     }
@@ -519,11 +558,13 @@ static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, cons
         if (i0 > i1 || j0 > j1) continue;
         written += t->small && fast ? fill_small(&F, &T, i0, j0, i1, j1) : fill_rect(&F, &T, t->id, i0, j0, i1, j1);
     }
-    if (opt->depth_bits == 16 || opt->depth_bits == 24) {
-        double lo = opt->depth == RASTER_DEPTH_NDC ? 0.0 : s->view->depth_near;
-        double hi = opt->depth == RASTER_DEPTH_NDC ? 1.0 : s->view->depth_far;
-        for (int j = tj0; j <= tj1; j++)
-            quantise(db->depth + (size_t)j * s->width + ti0, (size_t)(ti1 - ti0 + 1), opt->depth_bits, lo, hi);
+    bool quantised = opt->depth_bits == 16 || opt->depth_bits == 24;
+    double lo = opt->depth == RASTER_DEPTH_NDC ? 0.0 : s->view->depth_near;
+    double hi = opt->depth == RASTER_DEPTH_NDC ? 1.0 : s->view->depth_far;
+    for (int j = tj0; j <= tj1; j++) {
+        float *row = tile_row(&T, j, ti0);
+        if (quantised) quantise(row, (size_t)n, opt->depth_bits, lo, hi);
+        memcpy(db->depth + (size_t)j * s->width + ti0, row, sizeof *row * (size_t)n);
     }
     return written;
 }
@@ -560,22 +601,20 @@ static bool setup_chunk(const Setup *s, const RasterMesh *meshes, int num_meshes
 }
 
 /* Passes 3 and 4: bins from the per-thread counts, then the tiles. */
-static long bin_and_fill(const Setup *s, ThreadTris *tt, int nchunks, DepthBuffer *db, bool *ok)
+static long bin_and_fill(const Setup *s, RasterScratch *sc, int nchunks, DepthBuffer *db, bool *ok)
 {
+    ThreadTris *tt = sc->chunk;
     int ntiles = s->tiles_x * s->tiles_y;
-    int *bin_start = malloc(sizeof(int) * (size_t)(ntiles + 1));
-    int *cursor = malloc(sizeof(int) * (size_t)ntiles * (size_t)nchunks);
     long total = 0;
     for (int k = 0; k < nchunks; k++)
         for (int i = 0; i < tt[k].count; i++)
             total += (long)(tt[k].tri[i].i1 / TILE - tt[k].tri[i].i0 / TILE + 1) *
                      (tt[k].tri[i].j1 / TILE - tt[k].tri[i].j0 / TILE + 1);
-    const SnapTri **bins = total < (long)1 << 31 ? malloc(sizeof *bins * (size_t)(total > 0 ? total : 1)) : NULL;
-    if (!bin_start || !cursor || !bins) {
-        free(bin_start); free(cursor); free(bins);
-        *ok = false;
-        return 0;
-    }
+    int *bin_start = block_reserve(&sc->bin_start, sizeof(int) * (size_t)(ntiles + 1));
+    int *cursor = block_reserve(&sc->cursor, sizeof(int) * (size_t)ntiles * (size_t)nchunks);
+    const SnapTri **bins = total < (long)1 << 31 ? block_reserve(&sc->bins, sizeof *bins * (size_t)total) : NULL;
+    *ok = bin_start && cursor && bins;
+    if (!*ok) return 0;
     int at = 0;
     for (int tile = 0; tile < ntiles; tile++) { /* tile-major, thread order within a tile */
         bin_start[tile] = at;
@@ -597,8 +636,6 @@ static long bin_and_fill(const Setup *s, ThreadTris *tt, int nchunks, DepthBuffe
     long written = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : written)
     for (int tile = 0; tile < ntiles; tile++) written += fill_tile(s, tile, bins, bin_start, db);
-    free(bin_start); free(cursor); free(bins);
-    *ok = true;
     return written;
 }
 
@@ -617,6 +654,43 @@ static bool check_inputs(const RasterMesh *meshes, int num_meshes, const RasterV
     return true;
 }
 
+/* The scratch sized for this render: vertex arrays per mesh, and per chunk
+ * room for the whole chunk up front (most triangles survive, and growing
+ * copies them all) and zeroed tile counts. */
+static bool scratch_prepare(RasterScratch *sc, const RasterMesh *meshes, int num_meshes, const Setup *s, int nchunks,
+                            long chunk, Vertices *cv)
+{
+    size_t nv = 0;
+    for (int m = 0; m < num_meshes; m++) nv += (size_t)meshes[m].num_vertices;
+    RVertex *v = block_reserve(&sc->vertices, sizeof *v * nv);
+    ClipVertex *clip = block_reserve(&sc->clip, sizeof *clip * nv);
+    size_t ntiles = (size_t)s->tiles_x * (size_t)s->tiles_y;
+    int *counts = block_reserve(&sc->tile_counts, sizeof(int) * ntiles * (size_t)nchunks);
+    if (!v || !clip || !counts) return false;
+    for (int m = 0; m < num_meshes; v += meshes[m].num_vertices, clip += meshes[m].num_vertices, m++)
+        cv[m] = (Vertices){v, clip};
+    if (nchunks > sc->num_chunks) {
+        ThreadTris *n = realloc(sc->chunk, sizeof *n * (size_t)nchunks);
+        if (!n) return false;
+        memset(n + sc->num_chunks, 0, sizeof *n * (size_t)(nchunks - sc->num_chunks));
+        sc->chunk = n;
+        sc->num_chunks = nchunks;
+    }
+    memset(counts, 0, sizeof(int) * ntiles * (size_t)nchunks);
+    int cap = (int)(chunk < INT32_MAX / 2 ? chunk + 16 : INT32_MAX / 2);
+    for (int k = 0; k < nchunks; k++) {
+        ThreadTris *t = &sc->chunk[k];
+        if (t->cap < cap) {
+            free(t->tri);
+            t->tri = malloc(sizeof *t->tri * (size_t)cap);
+            t->cap = t->tri ? cap : 0;
+            if (!t->tri) return false;
+        }
+        *t = (ThreadTris){t->tri, 0, t->cap, counts + (size_t)k * ntiles, 0, 0};
+    }
+    return true;
+}
+
 bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *view, const RasterOptions *opt,
                   DepthBuffer *db, RasterStats *stats, Error *err)
 {
@@ -631,24 +705,12 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
     int nthreads = omp_get_max_threads();
     long by_size = total / CHUNK_TRIANGLES + 1;
     int nchunks = (int)(by_size < 4L * nthreads ? by_size : 4L * nthreads);
-    Vertices *cv = calloc((size_t)(num_meshes > 0 ? num_meshes : 1), sizeof *cv);
-    ThreadTris *tt = calloc((size_t)nchunks, sizeof *tt);
-    bool ok = cv && tt;
-    for (int m = 0; ok && m < num_meshes; m++) {
-        size_t nv = (size_t)(meshes[m].num_vertices > 0 ? meshes[m].num_vertices : 1);
-        cv[m].v = malloc(sizeof *cv[m].v * nv);
-        cv[m].clip = malloc(sizeof *cv[m].clip * nv);
-        ok = cv[m].v && cv[m].clip;
-        if (ok) transform_vertices(&s, &meshes[m], &cv[m]);
-    }
     long chunk = (total + nchunks - 1) / nchunks;
-    for (int k = 0; ok && k < nchunks; k++) {
-        /* Room for the whole chunk up front: most triangles survive, and growing copies them all. */
-        tt[k].cap = (int)(chunk < INT32_MAX / 2 ? chunk + 16 : INT32_MAX / 2);
-        tt[k].tri = malloc(sizeof *tt[k].tri * (size_t)tt[k].cap);
-        tt[k].tile_count = calloc((size_t)s.tiles_x * s.tiles_y, sizeof(int));
-        ok = tt[k].tri && tt[k].tile_count;
-    }
+    if (!db->scratch) db->scratch = calloc(1, sizeof *db->scratch);
+    Vertices *cv = calloc((size_t)(num_meshes > 0 ? num_meshes : 1), sizeof *cv);
+    bool ok = db->scratch && cv && scratch_prepare(db->scratch, meshes, num_meshes, &s, nchunks, chunk, cv);
+    ThreadTris *tt = ok ? db->scratch->chunk : NULL;
+    for (int m = 0; ok && m < num_meshes; m++) transform_vertices(&s, &meshes[m], &cv[m]);
     if (ok) {
         int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : failed)
@@ -656,21 +718,14 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
                                                               (k + 1) * chunk < total ? (k + 1) * chunk : total, &tt[k]);
         ok = failed == 0;
     }
-    long written = ok ? bin_and_fill(&s, tt, nchunks, db, &ok) : 0;
+    long written = ok ? bin_and_fill(&s, db->scratch, nchunks, db, &ok) : 0;
     RasterStats st = {total, 0, 0, 0, written};
-    for (int k = 0; tt && k < nchunks; k++) {
+    for (int k = 0; ok && k < nchunks; k++) {
         st.triangles_culled += tt[k].culled;
         st.triangles_clipped += tt[k].clipped;
         st.triangles_drawn += tt[k].count;
-        free(tt[k].tri);
-        free(tt[k].tile_count);
-    }
-    for (int m = 0; cv && m < num_meshes; m++) {
-        free(cv[m].v);
-        free(cv[m].clip);
     }
     free(cv);
-    free(tt);
     if (stats) *stats = st;
     if (!ok) return error_set(err, "raster: out of memory (%ld triangles into %dx%d)", total, db->width, db->height);
     return true;

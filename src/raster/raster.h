@@ -64,10 +64,18 @@ typedef struct RasterOptions {
 /* The output: depth per texel (+INFINITY where nothing was drawn with the
  * nearest test, -INFINITY with the farthest), and optionally triangle ids
  * (-1 where empty; ids count triangles across the meshes in order). */
+typedef struct RasterScratch RasterScratch; /* opaque: raster.c */
 typedef struct DepthBuffer {
     int width, height;
     float *depth;
     int32_t *triangle;
+    /* Working memory raster_depth keeps between renders into this buffer
+     * (transformed vertices, set-up triangles, tile bins: about 150 bytes
+     * per triangle), so a sweep or a cube map's faces do not fault fresh
+     * pages in at every render. NULL until the first render; released by
+     * depth_buffer_free, or by raster_scratch_free for buffers whose depth
+     * the caller owns. */
+    RasterScratch *scratch;
 } DepthBuffer;
 
 /* What a render did, for records and benchmarks. */
@@ -78,6 +86,7 @@ typedef struct RasterStats {
 
 bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids, Error *err);
 void depth_buffer_free(DepthBuffer *db);
+void raster_scratch_free(RasterScratch *scratch);
 
 /* Render the meshes into db (already sized; cleared here). */
 bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *view, const RasterOptions *opt,

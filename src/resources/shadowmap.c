@@ -117,11 +117,14 @@ static bool render_faces(ShadowMap *m, const MapArgs *a, const ShadowMap *under,
     int nm = caster_meshes(a->scene, meshes);
     size_t face_texels = (size_t)m->res * (size_t)m->res;
     bool ok = true;
+    RasterScratch *scratch = NULL; /* the faces' working memory, shared */
     for (int f = 0; ok && f < m->num_faces; f++) {
-        DepthBuffer db = {m->res, m->res, m->depth + f * face_texels, m->triangle ? m->triangle + f * face_texels : NULL};
+        DepthBuffer db = {m->res, m->res, m->depth + f * face_texels, m->triangle ? m->triangle + f * face_texels : NULL,
+                          scratch};
         RasterOptions opt = raster_options(&a->spec, under ? under->depth + f * face_texels : NULL);
         RasterStats st;
         ok = raster_depth(meshes, nm, &m->view.face[f].raster, &opt, &db, &st, err);
+        scratch = db.scratch;
         if (ok && a->spec.depth == RASTER_DEPTH_NDC) base_ndc_depths(&m->view, f, db.depth);
         for (size_t i = 0; opt.test == RASTER_FARTHEST && i < face_texels; i++) /* the map's empty: +INFINITY */
             if (db.depth[i] == -INFINITY) db.depth[i] = INFINITY;
@@ -131,6 +134,7 @@ static bool render_faces(ShadowMap *m, const MapArgs *a, const ShadowMap *under,
         m->stats.triangles_drawn += st.triangles_drawn;
         m->stats.texels_written += st.texels_written;
     }
+    raster_scratch_free(scratch);
     free(meshes);
     return ok;
 }

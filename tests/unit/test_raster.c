@@ -107,6 +107,33 @@ TEST(test_raster_back_face_culling_follows_the_winding)
     grid_free(&g);
 }
 
+/* A buffer's working memory is kept between renders (DepthBuffer.scratch):
+ * a render after a smaller mesh's and after a larger one's (the scratch
+ * grown, then reused as it is) equals a fresh buffer's. */
+TEST(test_raster_reused_scratch_renders_like_a_fresh_buffer)
+{
+    Grid small = grid_make(2, -0.5f, -0.5f, 0.5f, 0.0f), large = grid_make(60, -0.9f, -0.9f, 0.03f, 0.5f);
+    RasterView v = overhead_ortho();
+    RasterOptions opt = {0};
+    DepthBuffer reused, fresh;
+    Error err;
+    CHECK(depth_buffer_init(&reused, 200, 200, false, &err));
+    const RasterMesh *order[] = {&small.mesh, &large.mesh, &small.mesh, &large.mesh};
+    int differing = 0;
+    for (int k = 0; k < 4; k++) {
+        CHECK(raster_depth(order[k], 1, &v, &opt, &reused, NULL, &err));
+        CHECK(depth_buffer_init(&fresh, 200, 200, false, &err));
+        CHECK(raster_depth(order[k], 1, &v, &opt, &fresh, NULL, &err));
+        differing += memcmp(reused.depth, fresh.depth, sizeof(float) * 200 * 200) != 0;
+        depth_buffer_free(&fresh);
+    }
+    CHECK_MSG(reused.scratch != NULL, "the buffer kept no working memory");
+    CHECK_MSG(differing == 0, "%d of 4 renders into a reused buffer differ from a fresh buffer's", differing);
+    depth_buffer_free(&reused);
+    grid_free(&small);
+    grid_free(&large);
+}
+
 /* ---- against Embree ---------------------------------------------------- */
 
 static const char *const scene_text =
