@@ -83,11 +83,16 @@ static int run(const char *name, int stages, int argc, char **argv)
     }
     cli_apply_threads(&j.o);
     int status = EXIT_RUNTIME;
-    if (load(&j, &err) && lab_compare(j.lab, &j.req, &j.result, &err)) {
+    bool loaded = load(&j, &err);
+    if (loaded) { /* the first line before the work: what runs, on what */
+        report_print_header(j.lab, j.req.tech, j.req.light_index, stdout);
+        fflush(stdout);
+    }
+    if (loaded && lab_compare(j.lab, &j.req, &j.result, &err)) {
         if (j.result.ref_info.cache_note[0]) fprintf(stderr, "shadowlab: warning: %s\n", j.result.ref_info.cache_note);
         RunReport rep = compare_report(j.lab, &j.result, name, omp_get_max_threads());
         if (report_write_all(&rep, j.out_dir, !j.o.no_png, &err)) {
-            report_print(&rep, stdout);
+            report_print_body(&rep, stdout);
             printf("outputs: %s/%s.{exr,json%s}\n", j.out_dir, report_stem(&rep), j.o.no_png ? "" : ",png");
             status = EXIT_OK;
         }

@@ -243,11 +243,21 @@ void report_write_record_fp(const RunReport *r, FILE *fp)
 
 /* ---- the table for people ---------------------------------------------- */
 
+void report_print_header(const Lab *lab, const Technique *tech, int light_index, FILE *fp)
+{
+    const Scene *sc = lab_scene(lab);
+    fprintf(fp, "%s on %s (light %d: %s, %d triangles)\n", tech ? tech->name : "reference", sc->name,
+            light_index + 1, light_kind_name(sc->lights[light_index].kind), sc->num_triangles);
+}
+
 void report_print(const RunReport *r, FILE *fp)
 {
-    const Scene *sc = lab_scene(r->lab);
-    fprintf(fp, "%s on %s (light %d: %s, %d triangles)\n", r->tech ? r->tech->name : "reference", sc->name,
-            r->light_index + 1, light_kind_name(sc->lights[r->light_index].kind), sc->num_triangles);
+    report_print_header(r->lab, r->tech, r->light_index, fp);
+    report_print_body(r, fp);
+}
+
+void report_print_body(const RunReport *r, FILE *fp)
+{
     if (r->ref)
         fprintf(fp, "reference: %s, %d %s samples, %.3g s (%s), %.3g Mrays/s\n", measure_name(r->ref->params.measure),
                 r->ref->params.samples, sampling_pattern_name(r->ref->params.pattern), r->ref_info->seconds,

@@ -38,6 +38,11 @@ bool report_write_previews(const RunReport *r, const char *dir, Error *err);
 bool report_write_record(const RunReport *r, const char *path, Error *err);
 /* The same record onto an open stream (the Lua lab reads it from memory). */
 void report_write_record_fp(const RunReport *r, FILE *fp);
+/* The table for people: report_print_header's line (what runs on what),
+ * then the timings, metrics and resources. The CLI prints the header as
+ * soon as the scene is loaded and the rest when the run is done. */
+void report_print_header(const Lab *lab, const Technique *tech, int light_index, FILE *fp);
+void report_print_body(const RunReport *r, FILE *fp);
 void report_print(const RunReport *r, FILE *fp);
 
 #endif
