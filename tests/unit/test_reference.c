@@ -4,6 +4,7 @@
  * a shrinking sphere light, and self-intersection at a contact. */
 #include <math.h>
 #include <string.h>
+#include "core/mat4.h"
 #include "fixtures.h"
 #include "test.h"
 
@@ -244,6 +245,100 @@ TEST(test_reference_no_self_intersection_at_contact)
     printf("    %d ground samples (%d within 0.05 of the contact), %d wrong\n", checked, near_contact, wrong);
     CHECK(near_contact > 20);
     CHECK_MSG(wrong == 0, "%d ground samples disagree with the exact point-light shadow", wrong);
+    lab_close(lab);
+}
+
+/* Does the segment p -> q cross triangle abc? (Moller-Trumbore in double,
+ * the segment's open interior: 1e-9 < t < 1 - 1e-9) */
+static bool segment_hits_triangle(dvec3 p, dvec3 q, dvec3 a, dvec3 b, dvec3 c)
+{
+    dvec3 d = d3_sub(q, p), e1 = d3_sub(b, a), e2 = d3_sub(c, a), h = d3_cross(d, e2);
+    double det = d3_dot(e1, h);
+    if (fabs(det) < 1e-15) return false;
+    dvec3 s = d3_sub(p, a), qv = d3_cross(s, e1);
+    double u = d3_dot(s, h) / det, v = d3_dot(d, qv) / det, t = d3_dot(e2, qv) / det;
+    return u >= 0 && v >= 0 && u + v <= 1 && t > 1e-9 && t < 1 - 1e-9;
+}
+
+static bool segment_hits_objects(const Scene *sc, int first_object, dvec3 p, dvec3 q)
+{
+    for (int o = first_object; o < sc->num_objects; o++) {
+        const Mesh *m = &sc->objects[o].mesh;
+        for (int t = 0; t < m->num_triangles; t++) {
+            const uint32_t *ix = &m->indices[3 * t];
+            if (segment_hits_triangle(p, q, d3_from(m->positions[ix[0]]), d3_from(m->positions[ix[1]]),
+                                      d3_from(m->positions[ix[2]])))
+                return true;
+        }
+    }
+    return false;
+}
+
+/* Of a GRID x GRID lattice over the rect light scaled by `scale` about its
+ * centre (border included), how many points the ground point p sees, by
+ * exact segment tests against the boxes (objects 1..: the ground, object 0,
+ * cannot occlude its own points). */
+#define CONTACT_GRID 16
+static int lattice_visible(const Scene *sc, const Light *L, double scale, dvec3 p)
+{
+    dvec3 n = d3_from(L->direction), up = d3_from(L->up), right = d3_cross(up, n), c = d3_from(L->position);
+    int seen = 0;
+    for (int j = 0; j < CONTACT_GRID; j++)
+        for (int i = 0; i < CONTACT_GRID; i++) {
+            double x = ((double)i / (CONTACT_GRID - 1) - 0.5) * L->width * scale;
+            double y = ((double)j / (CONTACT_GRID - 1) - 0.5) * L->height * scale;
+            seen += !segment_hits_objects(sc, 1, p, d3_add(c, d3_add(d3_scale(right, x), d3_scale(up, y))));
+        }
+    return seen;
+}
+
+/* Is a box's base within r of ground point p? (8 horizontal segments 1 mm up) */
+static bool near_contact(const Scene *sc, dvec3 p, double r)
+{
+    dvec3 lifted = d3_add(p, d3(0, 1e-3, 0));
+    for (int k = 0; k < 8; k++) {
+        double a = k * M_PI / 4;
+        if (segment_hits_objects(sc, 1, lifted, d3_add(lifted, d3(r * cos(a), 0, r * sin(a))))) return true;
+    }
+    return false;
+}
+
+/* The shipped contact scene (boxes resting exactly on the floor under a
+ * rect light), at a reduced view: ground samples that see the whole
+ * lattice of a light 1.25x the size (a margin, so no shadow edge slips
+ * between lattice points into the light) must have visibility exactly 1 (a
+ * self-intersection would darken them), and those that see none of the
+ * light's own lattice at most 2% (slivers between lattice points). */
+TEST(test_reference_self_intersection_on_the_contact_scene)
+{
+    const char *ov[] = {"camera.width=160", "camera.height=120"};
+    Error err;
+    Lab *lab = lab_open("scenes/contact.lua", ov, 2, &err);
+    CHECK_MSG(lab, "%s", err.msg);
+    const Scene *sc = lab_scene(lab);
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), sc, &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), sc, 0, &err);
+    const Reference *ref = reference(lab, 256, SAMPLING_R2);
+    CHECK(vs && cls && ref && sc->lights[0].kind == LIGHT_RECT && strcmp(sc->objects[0].name, "ground") == 0);
+    int lit = 0, dark = 0, lit_wrong = 0, dark_wrong = 0, near = 0;
+    for (int s = 0; s < vs->count; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE || vs->object[s] != 0) continue;
+        dvec3 p = d3_from(vs->p_world[s]);
+        float v = ref->value.data[s];
+        if (lattice_visible(sc, &sc->lights[0], 1.25, p) == CONTACT_GRID * CONTACT_GRID) {
+            lit++;
+            lit_wrong += v != 1.0f;
+            near += near_contact(sc, p, 0.1);
+        } else if (lattice_visible(sc, &sc->lights[0], 1.0, p) == 0) {
+            dark++;
+            dark_wrong += v > 0.02f;
+        }
+    }
+    printf("    %d fully lit ground samples (%d within 10 cm of a contact), %d below 1; %d fully shadowed, %d above 0.02\n",
+           lit, near, lit_wrong, dark, dark_wrong);
+    CHECK(lit > 5000 && near > 40 && dark > 200);
+    CHECK_MSG(lit_wrong == 0, "%d fully lit ground samples are darkened (self-intersection)", lit_wrong);
+    CHECK_MSG(dark_wrong == 0, "%d fully shadowed ground samples see the light (leaks at the contact)", dark_wrong);
     lab_close(lab);
 }
 
