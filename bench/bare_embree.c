@@ -7,7 +7,12 @@
  * does. Rounds alternate bare, reference (after one untimed warm-up round);
  * every round checks that both saw the same rays, medians are reported and
  * one CSV row is added to reports/bench/reference_throughput.csv.
- * Usage: bare_embree [SCENE] [-n SAMPLES] [--threads N] [--repeat R] [-o CSV] */
+ * With --scaling, both instead run on the thread curve 1, 2, 4, ... N
+ * (bench.h's BenchCurve, bare then reference at each count, still checked
+ * against each other): the bare loop's own speed-up, the reference's, and
+ * their ratio (median of per-round reference / bare speed-ups, target >=
+ * 0.9 of the bare loop's scaling), one row per count, into the -o CSV.
+ * Usage: bare_embree [SCENE] [-n SAMPLES] [--threads N] [--repeat R] [--scaling] [-o CSV] */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -21,10 +26,14 @@
 #define SEED 1u
 #define PATTERN SAMPLING_R2
 #define CSV_HEADER "scene,triangles,samples,rays,bare_rays_per_s,reference_rays_per_s,ratio," BENCH_TAIL_HEADER "\n"
+#define SCALING_BOUND 0.9
+#define SCALING_HEADER "scene,triangles,samples,rays,bare_ms_1,bare_ms_n,bare_speedup,reference_ms_1," \
+                       "reference_ms_n,reference_speedup,ratio,bound,within," BENCH_TAIL_HEADER "\n"
 
 typedef struct Options {
     const char *scene, *csv;
     int samples, threads, repeat;
+    bool scaling;
 } Options;
 
 /* What both loops trace, fetched once (untimed). */
@@ -45,7 +54,8 @@ typedef struct Result {
 
 static int usage(const char *msg)
 {
-    fprintf(stderr, "bare_embree: %s\nusage: bare_embree [SCENE] [-n SAMPLES] [--threads N] [--repeat R] [-o CSV]\n",
+    fprintf(stderr,
+            "bare_embree: %s\nusage: bare_embree [SCENE] [-n SAMPLES] [--threads N] [--repeat R] [--scaling] [-o CSV]\n",
             msg);
     return 1;
 }
@@ -53,10 +63,11 @@ static int usage(const char *msg)
 static bool parse_options(int argc, char **argv, Options *o)
 {
     *o = (Options){"scenes/sphere-on-plane.lua", "reports/bench/reference_throughput.csv", 256,
-                   omp_get_max_threads(), 5};
+                   omp_get_max_threads(), 5, false};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         bool ok;
+        if (strcmp(a, "--scaling") == 0) { o->scaling = true; continue; }
         if (strcmp(a, "-n") == 0) ok = bench_parse_int(v, 1, REFERENCE_MAX_SAMPLES, &o->samples);
         else if (strcmp(a, "--threads") == 0) ok = bench_parse_int(v, 1, 1024, &o->threads);
         else if (strcmp(a, "--repeat") == 0) ok = bench_parse_int(v, 1, 1000, &o->repeat);
@@ -228,6 +239,70 @@ static bool measure(const Inputs *in, const Options *o, Result *res, Error *err)
     return ok;
 }
 
+/* ---- the thread curve ---------------------------------------------------- */
+
+/* What the curve's two sides share: side 0 is the bare loop, side 1 the
+ * reference, checked against the bare pass just before it. */
+typedef struct CurveRun {
+    const Inputs *in;
+    ReferenceParams prm;
+    long long bare_lit;
+} CurveRun;
+
+static bool curve_side(void *ctx, int side, int threads, double *seconds, Error *err)
+{
+    CurveRun *cr = ctx;
+    (void)threads;
+    double t0 = timer_now_s();
+    if (side == 0) {
+        cr->bare_lit = bare_trace(cr->in);
+        *seconds = timer_now_s() - t0;
+        return true;
+    }
+    Reference ref;
+    if (!reference_compute(cr->in->casters, cr->in->scene, cr->in->light_index, cr->in->vs, cr->in->cls, &cr->prm,
+                           &ref, err))
+        return false;
+    *seconds = timer_now_s() - t0;
+    bool ok = check_agreement(cr->in, &ref, cr->bare_lit, err);
+    reference_free(&ref);
+    return ok;
+}
+
+static bool scaling_rows(const Inputs *in, const Options *o, const BenchCurve *c, Error *err)
+{
+    char name[160];
+    bench_csv_field(name, sizeof name, in->scene->name);
+    printf("%s: %lld rays per pass, %d samples; speed-ups over 1 thread (medians of %d rounds):\n", in->scene->name,
+           in->rays, o->samples, c->rounds);
+    bool ok = true;
+    for (int k = 0; ok && k < c->points; k++) {
+        double b1 = bench_curve_median_s(c, 0, 0) * 1e3, bk = bench_curve_median_s(c, 0, k) * 1e3;
+        double r1 = bench_curve_median_s(c, 1, 0) * 1e3, rk = bench_curve_median_s(c, 1, k) * 1e3;
+        double bs = bench_curve_speedup(c, 0, k), rs = bench_curve_speedup(c, 1, k), ratio = bench_curve_relative(c, 1, 0, k);
+        bool within = ratio >= SCALING_BOUND;
+        printf("  %2d threads: bare %8.2f ms (x%.2f), reference %8.2f ms (x%.2f), ratio %.3f (bound %.1f)%s\n",
+               c->threads[k], bk, bs, rk, rs, ratio, SCALING_BOUND, within ? "" : "  UNDER");
+        char row[1024], tail[512];
+        bench_tail(tail, sizeof tail, c->threads[k]);
+        snprintf(row, sizeof row, "%s,%d,%d,%lld,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.1f,%s,%s\n", name,
+                 in->scene->num_triangles, o->samples, in->rays, b1, bk, bs, r1, rk, rs, ratio, SCALING_BOUND,
+                 within ? "yes" : "no", tail);
+        ok = bench_csv_append(o->csv, SCALING_HEADER, row, err);
+    }
+    return ok;
+}
+
+static bool scaling(const Inputs *in, const Options *o, Error *err)
+{
+    CurveRun cr = {in, ref_params(o), 0};
+    BenchCurve c;
+    bool ok = bench_curve_init(&c, o->threads, 2, o->repeat, err) && bench_curve_measure(&c, curve_side, &cr, err) &&
+              scaling_rows(in, o, &c, err);
+    bench_curve_free(&c);
+    return ok;
+}
+
 /* ---- the record --------------------------------------------------------- */
 
 /* Add one row to the CSV (bench.h: earlier rows kept under the same header). */
@@ -255,7 +330,13 @@ static bool bench(const Options *o, Error *err)
     if (!lab) return false;
     Inputs in;
     Result r = {0};
-    bool ok = load_inputs(lab, o, &in, err) && measure(&in, o, &r, err);
+    bool ok = load_inputs(lab, o, &in, err);
+    if (ok && o->scaling) {
+        ok = scaling(&in, o, err);
+        lab_close(lab);
+        return ok;
+    }
+    ok = ok && measure(&in, o, &r, err);
     if (ok) {
         print_summary(&in, o, &r);
         ok = append_csv(o->csv, &in, o, &r, err);

@@ -1,5 +1,6 @@
 /* bench.c -- the bench programs' shared CSV rows and helpers (bench.h). */
 #include "bench.h"
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -129,6 +130,147 @@ const ShadowMap *bench_map(Lab *lab, int res, Error *err)
         return NULL;
     }
     return m;
+}
+
+/* ---- a technique's light ------------------------------------------------- */
+
+/* Half the width of light l (see bench_lab_open). */
+static float light_half_width(const Light *l, const Scene *sc)
+{
+    switch (l->kind) {
+    case LIGHT_SPHERE:
+    case LIGHT_DISK: return l->radius;
+    case LIGHT_RECT:
+    case LIGHT_TEXTURED_RECT: return 0.5f * sqrtf(l->width * l->height);
+    default: return 0.01f * scene_extent(sc);
+    }
+}
+
+/* "lights[1]={...}": light 1 as `kind`, in place of the scene's own. */
+static void substitute_override(const Scene *sc, LightKind kind, char *out, size_t n, char *text, size_t tn)
+{
+    const Light *l = &sc->lights[0];
+    vec3 centre = v3_scale(v3_add(sc->bounds_min, sc->bounds_max), 0.5f);
+    vec3 p = l->kind == LIGHT_DIRECTIONAL ? v3_madd(centre, l->direction, -scene_extent(sc)) : l->position;
+    vec3 d = v3_normalize_or(v3_sub(centre, p), v3(0, -1, 0));
+    vec3 up = fabsf(d.y) < 0.9f ? v3(0, 1, 0) : v3(0, 0, -1); /* the loader orthonormalises it */
+    float r = light_half_width(l, sc);
+    int k = snprintf(out, n, "lights[1]={type=\"%s\", position={%.9g,%.9g,%.9g}, color={%.9g,%.9g,%.9g}, "
+                     "intensity=%.9g", light_kind_name(kind), p.x, p.y, p.z, l->color.x, l->color.y, l->color.z,
+                     l->intensity);
+    if (kind == LIGHT_RECT || kind == LIGHT_DISK)
+        k += snprintf(out + k, n - (size_t)k, ", direction={%.9g,%.9g,%.9g}", d.x, d.y, d.z);
+    if (kind == LIGHT_RECT)
+        k += snprintf(out + k, n - (size_t)k, ", up={%.9g,%.9g,%.9g}, width=%.9g, height=%.9g", up.x, up.y, up.z,
+                      2.0f * r, 2.0f * r);
+    if (kind == LIGHT_SPHERE || kind == LIGHT_DISK) k += snprintf(out + k, n - (size_t)k, ", radius=%.9g", r);
+    snprintf(out + k, n - (size_t)k, "}");
+    char size[48] = "";
+    if (kind == LIGHT_RECT) snprintf(size, sizeof size, " %.3g x %.3g", 2.0f * r, 2.0f * r);
+    if (kind == LIGHT_SPHERE || kind == LIGHT_DISK) snprintf(size, sizeof size, " r=%.3g", r);
+    snprintf(text, tn, "%s%s in place of %s", light_kind_name(kind), size, light_kind_name(l->kind));
+}
+
+/* The first kind of `substitutes` t handles, or -1. */
+static int substitute_kind(const Technique *t)
+{
+    static const LightKind substitutes[] = {LIGHT_RECT, LIGHT_SPHERE, LIGHT_DISK, LIGHT_POINT};
+    for (int s = 0; s < 4; s++)
+        if (t->lights & LIGHT_BIT(substitutes[s])) return (int)substitutes[s];
+    return -1;
+}
+
+Lab *bench_lab_open(const char *scene, const Technique *t, const char *const *overrides, int n, BenchLight *used,
+                    Error *err)
+{
+    const char *ov[BENCH_MAX_OVERRIDES];
+    char light[1000];
+    if (n >= BENCH_MAX_OVERRIDES) {
+        error_set(err, "more than %d scene overrides", BENCH_MAX_OVERRIDES - 1);
+        return NULL;
+    }
+    Lab *lab = lab_open(scene, overrides, n, err);
+    if (!lab) return NULL;
+    int first;
+    if (!lab_light_index(lab, 1, &first, err)) {
+        lab_close(lab);
+        return NULL;
+    }
+    const Light *l = &lab_scene(lab)->lights[first];
+    *used = (BenchLight){.substituted = !(t->lights & LIGHT_BIT(l->kind))};
+    snprintf(used->text, sizeof used->text, "%s", light_kind_name(l->kind));
+    if (!used->substituted) return lab;
+    int kind = substitute_kind(t);
+    if (kind >= 0) {
+        substitute_override(lab_scene(lab), (LightKind)kind, light, sizeof light, used->text, sizeof used->text);
+    } else {
+        tech_check_light(t, l, 1, err); /* fails, naming the kinds t handles */
+        error_prefix(err, "%s: no rect, sphere, disk or point light can replace light 1: ", scene);
+    }
+    lab_close(lab);
+    if (kind < 0) return NULL;
+    for (int i = 0; i < n; i++) ov[i] = overrides[i];
+    ov[n] = light;
+    return lab_open(scene, ov, n + 1, err);
+}
+
+/* ---- thread-scaling curves ------------------------------------------------ */
+
+bool bench_curve_init(BenchCurve *c, int max_threads, int sides, int rounds, Error *err)
+{
+    *c = (BenchCurve){.sides = sides, .rounds = rounds};
+    if (rounds < 1 || rounds > 1000 || max_threads < 1) return error_set(err, "curve: rounds in [1, 1000], threads >= 1");
+    for (int k = 1; k < max_threads && c->points < BENCH_MAX_CURVE - 1; k *= 2) c->threads[c->points++] = k;
+    c->threads[c->points++] = max_threads;
+    c->s = malloc(sizeof *c->s * (size_t)(sides * c->points * rounds));
+    return c->s || error_set(err, "out of memory");
+}
+
+static double *curve_at(const BenchCurve *c, int side, int k) { return c->s + (side * c->points + k) * c->rounds; }
+
+/* Every side at every count once; times into round r (r < 0: untimed). */
+static bool curve_round(BenchCurve *c, BenchTimedFn fn, void *ctx, int r, Error *err)
+{
+    for (int k = 0; k < c->points; k++) {
+        omp_set_num_threads(c->threads[k]);
+        for (int side = 0; side < c->sides; side++) {
+            double s;
+            if (!fn(ctx, side, c->threads[k], &s, err)) return false;
+            if (r >= 0) curve_at(c, side, k)[r] = s;
+        }
+    }
+    return true;
+}
+
+bool bench_curve_measure(BenchCurve *c, BenchTimedFn fn, void *ctx, Error *err)
+{
+    bool ok = curve_round(c, fn, ctx, -1, err);
+    for (int r = 0; ok && r < c->rounds; r++) ok = curve_round(c, fn, ctx, r, err);
+    omp_set_num_threads(c->threads[c->points - 1]);
+    return ok;
+}
+
+double bench_curve_median_s(const BenchCurve *c, int side, int k) { return bench_median(curve_at(c, side, k), c->rounds); }
+
+/* t(1) / t(k) of `side` in one round. */
+static double round_speedup(const BenchCurve *c, int side, int k, int round)
+{
+    return curve_at(c, side, 0)[round] / curve_at(c, side, k)[round];
+}
+
+double bench_curve_relative(const BenchCurve *c, int a, int b, int k)
+{
+    double v[1000];
+    for (int r = 0; r < c->rounds; r++) v[r] = round_speedup(c, a, k, r) / (b < 0 ? 1.0 : round_speedup(c, b, k, r));
+    return bench_median(v, c->rounds);
+}
+
+double bench_curve_speedup(const BenchCurve *c, int side, int k) { return bench_curve_relative(c, side, -1, k); }
+
+void bench_curve_free(BenchCurve *c)
+{
+    free(c->s);
+    c->s = NULL;
 }
 
 /* One common option (or a scene path) at argv[i]: arguments taken, 0 if not common, -1 malformed. */

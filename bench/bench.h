@@ -58,4 +58,45 @@ int bench_casters(const Scene *scene, RasterMesh *out, int max, long *triangles)
  * `res`, z_ndc, fitted to the scene (one face, whatever the light). */
 const ShadowMap *bench_map(Lab *lab, int res, Error *err);
 
+/* The light a technique was measured under (bench_lab_open), for its rows. */
+typedef struct BenchLight {
+    char text[160];   /* "sphere", or "rect 0.8 x 0.8 in place of sphere r=0.4" */
+    bool substituted;
+} BenchLight;
+#define BENCH_MAX_OVERRIDES 8
+/* Open `scene` with `overrides` (at most BENCH_MAX_OVERRIDES - 1) for
+ * technique t. Where t does not handle light 1's kind (Technique.lights,
+ * tech_check_light), light 1 is replaced by one of the first kind t handles
+ * among rect, sphere, disk, point: same centre (a directional light's: one
+ * scene extent back along its direction), as wide (a square of side 2r, a
+ * sphere or disk of radius r, where r is the scene light's radius, half the
+ * side of a square of its rectangle's area, or 1% of the scene's extent for a
+ * delta light), facing the scene's centre, same colour and intensity. *used
+ * says which. Fails, naming the kinds, where t handles none of those. */
+Lab *bench_lab_open(const char *scene, const Technique *t, const char *const *overrides, int n, BenchLight *used,
+                    Error *err);
+
+/* A thread-scaling curve (issue 8, item 5): 1, 2, 4, ... below N, then N,
+ * each of `sides` things timed at every count in every round, after one
+ * untimed run of each at each count. Speed-ups are medians of per-round
+ * ratios t(1) / t(k), so a round the shared machine slowed cancels. */
+#define BENCH_MAX_CURVE 12
+typedef struct BenchCurve {
+    int threads[BENCH_MAX_CURVE], points, sides, rounds;
+    double *s; /* seconds, s[(side * points + k) * rounds + round] */
+} BenchCurve;
+/* One timed run of `side` at `threads` (OpenMP already set to it). */
+typedef bool (*BenchTimedFn)(void *ctx, int side, int threads, double *seconds, Error *err);
+bool bench_curve_init(BenchCurve *c, int max_threads, int sides, int rounds, Error *err);
+/* Every round, then OpenMP back at the curve's largest count. */
+bool bench_curve_measure(BenchCurve *c, BenchTimedFn fn, void *ctx, Error *err);
+/* Median seconds of `side` at point k. */
+double bench_curve_median_s(const BenchCurve *c, int side, int k);
+/* Median over rounds of the per-round speed-up t(1) / t(k) of `side`. */
+double bench_curve_speedup(const BenchCurve *c, int side, int k);
+/* Median over rounds of side a's per-round speed-up at point k divided by
+ * side b's (b < 0: by 1), e.g. a program's scaling against a bare loop's. */
+double bench_curve_relative(const BenchCurve *c, int a, int b, int k);
+void bench_curve_free(BenchCurve *c);
+
 #endif

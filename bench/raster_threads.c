@@ -1,11 +1,12 @@
 /* raster_threads.c -- the rasterizer's thread scaling (issue 8, item 5) and
  * the driver its profiles run under: raster_depth of light 1's map of each
- * scene (bench_map: perspective, z_ndc) at each --res, at 1 thread and at
- * --threads N, alternating within every round after one warm-up at each;
- * the speed-up is the median of the per-round ratios t(1) / t(N). One row
- * per scene and size in DIR/raster_threads.csv. With --profile only N
- * threads run, --repeat times, and nothing is written (for perf and
- * callgrind: `valgrind --tool=callgrind raster_threads --profile ...`).
+ * scene (bench_map: perspective, z_ndc) at each --res, on the curve 1, 2,
+ * 4, ... N threads (N = --threads; bench.h's BenchCurve: every count in
+ * every round after one warm-up at each); a point's speed-up is the median
+ * of the per-round ratios t(1) / t(k). One row per scene, size and thread
+ * count in DIR/raster_threads.csv. With --profile only N threads run,
+ * --repeat times, and nothing is written (for perf and callgrind:
+ * `valgrind --tool=callgrind raster_threads --profile ...`).
  * Usage: raster_threads [--res R]... [--threads N] [--repeat R] [--profile]
  *                       [-o DIR] SCENE... */
 #include <omp.h>
@@ -58,19 +59,11 @@ static bool timed_render(Job *j, int threads, double *seconds, Error *err)
     return ok;
 }
 
-/* Rounds of (1 thread, N threads); med = {t1, tN, t1/tN}. */
-static bool measure(Job *j, const Options *o, double med[3], Error *err)
+/* BenchTimedFn: one render at the curve's thread count. */
+static bool curve_render(void *job, int side, int threads, double *seconds, Error *err)
 {
-    double *t = malloc(sizeof *t * 3 * (size_t)o->c.repeat), w;
-    if (!t) return error_set(err, "out of memory");
-    bool ok = timed_render(j, 1, &w, err) && timed_render(j, o->c.threads, &w, err);
-    for (int i = 0; ok && i < o->c.repeat; i++) {
-        ok = timed_render(j, 1, &t[i], err) && timed_render(j, o->c.threads, &t[o->c.repeat + i], err);
-        t[2 * o->c.repeat + i] = t[i] / t[o->c.repeat + i];
-    }
-    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->c.repeat, o->c.repeat);
-    free(t);
-    return ok;
+    (void)side;
+    return timed_render(job, threads, seconds, err);
 }
 
 static bool profile(Job *j, const Options *o, Error *err)
@@ -83,17 +76,35 @@ static bool profile(Job *j, const Options *o, Error *err)
     return true;
 }
 
-static bool write_row(const Options *o, const Scene *sc, const Job *j, const double med[3], Error *err)
+/* One row per point of the curve (threads = that point's count). */
+static bool write_rows(const Options *o, const Scene *sc, const Job *j, const BenchCurve *c, Error *err)
 {
-    char row[1024], tail[512], name[160], path[4096];
-    bench_tail(tail, sizeof tail, o->c.threads);
-    bench_csv_field(name, sizeof name, sc->name);
-    snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%ld,%s\n", name, j->triangles, j->db.width, med[0] * 1e3,
-             med[1] * 1e3, med[2], j->stats.texels_written, tail);
-    printf("  %5d^2: 1 thread %8.2f ms, %d threads %8.2f ms, speed-up %.2f\n", j->db.width, med[0] * 1e3, o->c.threads,
-           med[1] * 1e3, med[2]);
+    char path[4096], name[160];
     snprintf(path, sizeof path, "%s/raster_threads.csv", o->c.dir);
-    return bench_csv_append(path, HEADER, row, err);
+    bench_csv_field(name, sizeof name, sc->name);
+    double ms1 = bench_curve_median_s(c, 0, 0) * 1e3;
+    printf("  %5d^2: 1 thread %8.2f ms", j->db.width, ms1);
+    bool ok = true;
+    for (int k = 0; ok && k < c->points; k++) {
+        char row[1024], tail[512];
+        double msk = bench_curve_median_s(c, 0, k) * 1e3, speedup = bench_curve_speedup(c, 0, k);
+        bench_tail(tail, sizeof tail, c->threads[k]);
+        snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%ld,%s\n", name, j->triangles, j->db.width, ms1, msk,
+                 speedup, j->stats.texels_written, tail);
+        if (k > 0) printf("; %d: %.2f ms, speed-up %.2f", c->threads[k], msk, speedup);
+        ok = bench_csv_append(path, HEADER, row, err);
+    }
+    printf("\n");
+    return ok;
+}
+
+static bool curve(Lab *lab, Job *j, const Options *o, Error *err)
+{
+    BenchCurve c;
+    bool ok = bench_curve_init(&c, o->c.threads, 1, o->c.repeat, err) &&
+              bench_curve_measure(&c, curve_render, j, err) && write_rows(o, lab_scene(lab), j, &c, err);
+    bench_curve_free(&c);
+    return ok;
 }
 
 static bool bench_size(Lab *lab, Job *j, const Options *o, int res, Error *err)
@@ -102,8 +113,7 @@ static bool bench_size(Lab *lab, Job *j, const Options *o, int res, Error *err)
     if (!map || !depth_buffer_init(&j->db, res, res, false, err)) return false;
     j->view = &map->view.face[0].raster;
     j->opt = (RasterOptions){.depth = RASTER_DEPTH_NDC};
-    double med[3];
-    bool ok = o->profile ? profile(j, o, err) : measure(j, o, med, err) && write_row(o, lab_scene(lab), j, med, err);
+    bool ok = o->profile ? profile(j, o, err) : curve(lab, j, o, err);
     depth_buffer_free(&j->db);
     return ok;
 }

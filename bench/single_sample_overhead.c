@@ -6,31 +6,27 @@
  * then rounds alternating primary rays, hard and single_sample_rt. Reported:
  * the median per-round ratio of the shadow queries, single_sample_rt / hard,
  * and of a whole ray tracer without shading, (primary + single_sample_rt) /
- * (primary + hard), the paper's measure. One CSV row per scene and light
- * radius, written afresh (atomically) to reports/bench/single_sample_overhead.csv.
- * Usage: single_sample_overhead [--radius R]... [--threads N] [--repeat R] [-o CSV] SCENE... */
+ * (primary + hard), the paper's measure. One row per scene and light radius
+ * in DIR/single_sample_overhead.csv, started afresh, ending in bench_tail's
+ * columns like every bench CSV.
+ * Usage: single_sample_overhead [--radius R]... [--threads N] [--repeat R] [-o DIR] SCENE... */
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
-#include "core/fsutil.h"
+#include "bench.h"
 #include "core/timer.h"
-#include "lab/lab.h"
-#include "version.h"
 
 #define MAX_ITEMS 16
-#define CSV_HEADER                                                                                               \
-    "scene,triangles,light,radius,threads,rounds,primary_s,hard_s,single_sample_s,shadow_ratio,ray_tracer_ratio," \
-    "outer_build_s,outer_bytes,commit,date\n"
+#define CSV_HEADER                                                                                                 \
+    "scene,triangles,light,radius,rounds,primary_s,hard_s,single_sample_s,shadow_ratio,ray_tracer_ratio,"          \
+    "outer_build_s,outer_bytes," BENCH_TAIL_HEADER "\n"
 
 typedef struct Options {
-    const char *scenes[MAX_ITEMS];
-    int num_scenes;
+    BenchCommon c;
     double radii[MAX_ITEMS]; /* lights[1].radius overrides; none: the scene's own */
     int num_radii;
-    int threads, repeat;
-    const char *csv;
+    char csv[4096];
 } Options;
 
 typedef struct Row {
@@ -41,36 +37,24 @@ typedef struct Row {
     size_t outer_bytes;
 } Row;
 
-static bool parse_number(const char *s, double lo, double hi, double *out)
+static int own_option(void *options, const char *a, const char *v)
 {
+    Options *o = options;
     char *end;
-    double v = s ? strtod(s, &end) : 0;
-    if (!s || end == s || *end != '\0' || !(v >= lo && v <= hi)) return false;
-    *out = v;
-    return true;
+    double r = v ? strtod(v, &end) : 0.0;
+    if (strcmp(a, "--radius") != 0 || !v || end == v || *end != '\0' || !(r >= 1e-9 && r <= 1e6) ||
+        o->num_radii == MAX_ITEMS)
+        return 0;
+    o->radii[o->num_radii++] = r;
+    return 2;
 }
 
 static bool parse_options(int argc, char **argv, Options *o)
 {
-    *o = (Options){.threads = omp_get_max_threads(), .repeat = 9, .csv = "reports/bench/single_sample_overhead.csv"};
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        double x = 0;
-        bool ok = true;
-        if (a[0] != '-') {
-            if (o->num_scenes == MAX_ITEMS) return false;
-            o->scenes[o->num_scenes++] = a;
-            continue;
-        }
-        if (strcmp(a, "--radius") == 0 && o->num_radii < MAX_ITEMS) ok = parse_number(v, 1e-9, 1e6, &o->radii[o->num_radii++]);
-        else if (strcmp(a, "--threads") == 0) ok = parse_number(v, 1, 1024, &x), o->threads = (int)x;
-        else if (strcmp(a, "--repeat") == 0) ok = parse_number(v, 1, 1000, &x), o->repeat = (int)x;
-        else if (strcmp(a, "-o") == 0) ok = (o->csv = v) != NULL;
-        else return false;
-        if (!ok) return false;
-        i++;
-    }
-    if (o->num_scenes == 0) o->scenes[o->num_scenes++] = "scenes/sphere-on-plane.lua";
+    *o = (Options){.num_radii = 0};
+    if (!bench_parse(argc, argv, 9, &o->c, own_option, o)) return false;
+    if (o->c.num_scenes == 0) o->c.scenes[o->c.num_scenes++] = "scenes/sphere-on-plane.lua";
+    snprintf(o->csv, sizeof o->csv, "%s/single_sample_overhead.csv", o->c.dir);
     return true;
 }
 
@@ -114,7 +98,7 @@ static bool time_primary(Lab *lab, double *seconds, Error *err)
 /* Rounds of primary, hard, single_sample_rt; medians of times and ratios. */
 static bool measure(Lab *lab, const Options *o, Row *row, Error *err)
 {
-    int n = o->repeat;
+    int n = o->c.repeat;
     double warm, *t = malloc(sizeof(double) * 5 * (size_t)n);
     if (!t) return error_set(err, "out of memory");
     double *primary = t, *hard = t + n, *ss = t + 2 * n, *shadow = t + 3 * n, *tracer = t + 4 * n;
@@ -134,22 +118,20 @@ static bool measure(Lab *lab, const Options *o, Row *row, Error *err)
     return ok;
 }
 
-static void write_row(FILE *fp, const Row *r, const Options *o)
+static bool write_row(const Row *r, const Options *o, Error *err)
 {
-    char date[32], name[SCENE_NAME_MAX];
-    time_t now = time(NULL);
-    strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", gmtime(&now));
-    snprintf(name, sizeof name, "%s", r->scene->name);
-    for (char *c = name; *c; c++)
-        if (*c == ',' || *c == '"' || *c == '\n') *c = '_';
+    char row[1024], name[160], tail[512];
+    bench_csv_field(name, sizeof name, r->scene->name);
+    bench_tail(tail, sizeof tail, o->c.threads);
     const Light *l = &r->scene->lights[0];
-    fprintf(fp, "%s,%d,%s,%.6g,%d,%d,%.6g,%.6g,%.6g,%.4f,%.4f,%.6g,%zu,%s,%s\n", name, r->scene->num_triangles,
-            light_kind_name(l->kind), (double)l->radius, o->threads, o->repeat, r->primary_s, r->hard_s, r->ss_s,
-            r->shadow_ratio, r->tracer_ratio, r->outer_build_s, r->outer_bytes, SHADOWLAB_COMMIT, date);
+    snprintf(row, sizeof row, "%s,%d,%s,%.6g,%d,%.6g,%.6g,%.6g,%.4f,%.4f,%.6g,%zu,%s\n", name,
+             r->scene->num_triangles, light_kind_name(l->kind), (double)l->radius, o->c.repeat, r->primary_s,
+             r->hard_s, r->ss_s, r->shadow_ratio, r->tracer_ratio, r->outer_build_s, r->outer_bytes, tail);
+    return bench_csv_append(o->csv, CSV_HEADER, row, err);
 }
 
 /* One scene at one light radius (radius < 0: as the scene has it). */
-static bool bench_one(const char *path, double radius, const Options *o, FILE *csv, Error *err)
+static bool bench_one(const char *path, double radius, const Options *o, Error *err)
 {
     char assign[64];
     snprintf(assign, sizeof assign, "lights[1].radius=%.9g", radius);
@@ -163,9 +145,9 @@ static bool bench_one(const char *path, double radius, const Options *o, FILE *c
         printf("%s (%d triangles, %s light, radius %g): primary %.4f s, hard %.4f s, single_sample_rt %.4f s; "
                "shadow rays x%.3f, ray tracer x%.3f (medians of %d rounds, %d threads); outer objects %.4f s\n",
                row.scene->name, row.scene->num_triangles, light_kind_name(l->kind), (double)l->radius,
-               row.primary_s, row.hard_s, row.ss_s, row.shadow_ratio, row.tracer_ratio, o->repeat, o->threads,
+               row.primary_s, row.hard_s, row.ss_s, row.shadow_ratio, row.tracer_ratio, o->c.repeat, o->c.threads,
                row.outer_build_s);
-        write_row(csv, &row, o);
+        ok = write_row(&row, o, err);
     }
     lab_close(lab);
     return ok;
@@ -173,21 +155,11 @@ static bool bench_one(const char *path, double radius, const Options *o, FILE *c
 
 static bool bench_all(const Options *o, Error *err)
 {
-    char dir[4096];
-    snprintf(dir, sizeof dir, "%s", o->csv);
-    char *slash = strrchr(dir, '/');
-    if (slash) *slash = '\0';
-    if (slash && !mkdir_p(dir, err)) return false;
-    AtomicFile af;
-    if (!atomic_open(&af, o->csv, err)) return false;
-    fputs(CSV_HEADER, af.fp);
-    for (int i = 0; i < o->num_scenes; i++)
+    if (!bench_csv_reset(o->csv, CSV_HEADER, err)) return false;
+    for (int i = 0; i < o->c.num_scenes; i++)
         for (int k = 0; k < (o->num_radii ? o->num_radii : 1); k++)
-            if (!bench_one(o->scenes[i], o->num_radii ? o->radii[k] : -1, o, af.fp, err)) {
-                atomic_abort(&af);
-                return error_prefix(err, "%s: ", o->scenes[i]);
-            }
-    if (!atomic_commit(&af, err)) return false;
+            if (!bench_one(o->c.scenes[i], o->num_radii ? o->radii[k] : -1, o, err))
+                return error_prefix(err, "%s: ", o->c.scenes[i]);
     printf("results: %s\n", o->csv);
     return true;
 }
@@ -195,16 +167,10 @@ static bool bench_all(const Options *o, Error *err)
 int main(int argc, char **argv)
 {
     Options o;
-    if (!parse_options(argc, argv, &o)) {
-        fprintf(stderr, "usage: single_sample_overhead [--radius R]... [--threads N] [--repeat R] [-o CSV] SCENE...\n");
-        return 2;
-    }
-    omp_set_num_threads(o.threads);
-    rt_set_threads(o.threads);
+    if (!parse_options(argc, argv, &o))
+        return bench_usage("single_sample_overhead [--radius R]... [--threads N] [--repeat R] [-o DIR] SCENE...");
+    omp_set_num_threads(o.c.threads);
+    rt_set_threads(o.c.threads);
     Error err;
-    if (!bench_all(&o, &err)) {
-        fprintf(stderr, "single_sample_overhead: %s\n", err.msg);
-        return 1;
-    }
-    return 0;
+    return bench_all(&o, &err) ? 0 : bench_fail("single_sample_overhead", &err);
 }
