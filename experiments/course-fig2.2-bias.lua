@@ -41,12 +41,13 @@ local page = figures.page(result.out, "Course Fig. 2.2: acne against leaks as th
 for _, kind in ipairs({ "constant", "slope" }) do
   local function swept(r) return kind == "constant" and r.params.slope_bias == 0 and r.params.bias or r.params.slope_bias end
   local function mine(r) return kind == "constant" and r.params.slope_bias == 0 or (kind == "slope" and r.params.bias == 0) end
-  local rows_table = {}
+  local rows_table, used = {}, {}
   local series = { acne = {}, leaks = {} }
   for _, g in ipairs(figures.group(result, function(r) return r.variant.scene end, swept)) do
     local pts = { acne = {}, leaks = {} }
     for _, r in ipairs(g.rows) do
       if mine(r) then
+        used[#used + 1] = r
         local x = swept(r) > 0 and swept(r) or ZERO_AT[kind]
         pts.acne[#pts.acne + 1] = { x, 100 * figures.acne(r) }
         pts.leaks[#pts.leaks + 1] = { x, 100 * figures.leaks(r) }
@@ -64,7 +65,7 @@ for _, kind in ipairs({ "constant", "slope" }) do
     page:plot("fig2.2-" .. kind .. "-" .. what, {
       title = (what == "acne" and "Acne (false shadow on lit surfaces)" or "Leaks (false lit in shadow)") ..
               " against the " .. kind .. " bias (sm, 1024^2 map)",
-      subtitle = string.format("240x180 views; 0 drawn at %g", ZERO_AT[kind]),
+      rows = used, subtitle = string.format("0 drawn at %g", ZERO_AT[kind]),
       xlabel = kind == "constant" and "constant bias (world units, log scale)" or "slope bias (x depth slope, log scale)",
       ylabel = "% of light-facing samples", logx = true, series = series[what],
     })

@@ -41,13 +41,14 @@ local page = figures.page(result.out, "Course Fig. 2.3: where midpoint shadow ma
   "and map size. No constant or slope bias except the baseline.")
 for _, scene in ipairs({ "contact", "cones-and-hills" }) do
   local series = { acne = {}, leaks = {} }
-  local rows_table = {}
+  local rows_table, used = {}, {}
   for _, g in ipairs(figures.group(result, function(r) return r.variant.scene .. "|" .. mode(r) end,
                                    function(r) return r.params.map_size end)) do
     if g.key:match("^[^|]*") == scene then
       local label = g.key:match("|(.*)$")
       local pts = { acne = {}, leaks = {} }
       for _, r in ipairs(g.rows) do
+        used[#used + 1] = r
         pts.acne[#pts.acne + 1] = { r.params.map_size, 100 * figures.acne(r) }
         pts.leaks[#pts.leaks + 1] = { r.params.map_size, 100 * figures.leaks(r) }
         rows_table[#rows_table + 1] = { label, tostring(r.params.map_size), string.format("%.3f", 100 * figures.leaks(r)),
@@ -64,7 +65,7 @@ for _, scene in ipairs({ "contact", "cones-and-hills" }) do
     page:plot("fig2.3-" .. scene .. "-" .. what, {
       title = (what == "leaks" and "False lit (incorrect unshadowing)" or "False shadow (incorrect self-shadowing)") ..
               " on " .. scene,
-      subtitle = "sm depth layers without bias; 240x180 views", xlabel = "map size (texels per side, log scale)",
+      rows = used, subtitle = "sm depth layers without bias", xlabel = "map size (texels per side, log scale)",
       ylabel = "% of light-facing samples", logx = true, series = series[what],
     })
   end

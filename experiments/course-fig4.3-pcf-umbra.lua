@@ -33,7 +33,7 @@ if result.sharded then return end
 local page = figures.page(result.out, "Course Fig. 4.3: PCF's umbra is too large, its penumbra too small",
   "Share of the light-facing samples in umbra (V <= 0.01) and penumbra (0.01 < V < 0.99), PCF (box, 1024^2 map) " ..
   "against the Embree reference, for sphere-on-plane with light radius 0.1 and 0.4 (the ball's is 0.6).")
-local umbra, penumbra, rows_table = {}, {}, {}
+local umbra, penumbra, rows_table, runs = {}, {}, {}, {}
 for _, radius in ipairs(RADII) do
   local overrides = { ["lights[1].radius"] = radius }
   for k, v in pairs(VIEW) do overrides[k] = v end
@@ -44,6 +44,7 @@ for _, radius in ipairs(RADII) do
     local run = lab:compare{ technique = "pcf", params = { K = K, kernel = "box" }, samples = SAMPLES, png = false,
                              exr = false }
     local a, m = figures.areas(run), run:metrics()
+    runs[#runs + 1] = run:record()
     ref_area = a
     u[#u + 1] = { K, 100 * a.umbra }
     p[#p + 1] = { K, 100 * a.penumbra }
@@ -62,11 +63,10 @@ for _, radius in ipairs(RADII) do
                               points = { { KERNELS[1], 100 * ref_area.ref_penumbra },
                                          { KERNELS[#KERNELS], 100 * ref_area.ref_penumbra } } }
 end
-local sub = string.format("sphere-on-plane, 240x180, reference %d R2 samples", SAMPLES)
-page:plot("fig4.3-umbra", { title = "Umbra area against K", subtitle = sub, xlabel = "K (texels)",
-                            ylabel = "% of light-facing samples", series = umbra })
-page:plot("fig4.3-penumbra", { title = "Penumbra area against K", subtitle = sub, xlabel = "K (texels)",
-                               ylabel = "% of light-facing samples", series = penumbra })
+page:plot("fig4.3-umbra", { title = "Umbra area against K", rows = runs, subtitle = "light radius 0.1 and 0.4",
+                            xlabel = "K (texels)", ylabel = "% of light-facing samples", series = umbra })
+page:plot("fig4.3-penumbra", { title = "Penumbra area against K", rows = runs, subtitle = "light radius 0.1 and 0.4",
+                               xlabel = "K (texels)", ylabel = "% of light-facing samples", series = penumbra })
 page:table({ "radius", "K", "umbra % (pcf)", "umbra % (ref)", "penumbra % (pcf)", "penumbra % (ref)", "umbra RMSE",
              "penumbra RMSE" }, rows_table)
 page:write()

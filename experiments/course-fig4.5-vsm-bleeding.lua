@@ -36,7 +36,7 @@ local page = figures.page(result.out, "Course Fig. 4.5: VSM's light bleeding whe
   "reference, 0) over the samples the reference puts in umbra (V <= 0.01); penumbra over-darkening: the mean of " ..
   "max(reference - estimate, 0) in its penumbra.")
 local function umbra_leak(r) return r.record.metrics.umbra.leak_mean end
-local series, rows_table = {}, {}
+local series, rows_table, used = {}, {}, {}
 for _, g in ipairs(figures.group(result, function(r)
   if r.params.bleed_reduction and r.params.bleed_reduction > 0 then return "vsm, bleeding reduction" end
   if r.technique == "lvsm" then return "lvsm" end
@@ -44,7 +44,10 @@ for _, g in ipairs(figures.group(result, function(r)
 end, function(r) return r.params.K * 100 + (r.params.layers or 0) + (r.params.bleed_reduction or 0) end)) do
   local pts = {}
   for _, r in ipairs(g.rows) do
-    if g.key == r.technique then pts[#pts + 1] = { r.params.K, umbra_leak(r) } end
+    if g.key == r.technique then
+      pts[#pts + 1] = { r.params.K, umbra_leak(r) }
+      used[#used + 1] = r
+    end
     local what = r.technique == "lvsm" and string.format("layers=%d", r.params.layers) or
                  (r.params.bleed_reduction and r.params.bleed_reduction > 0) and
                  string.format("bleed_reduction=%g", r.params.bleed_reduction) or ""
@@ -54,7 +57,7 @@ end, function(r) return r.params.K * 100 + (r.params.layers or 0) + (r.params.bl
   end
   if #pts > 1 then series[#series + 1] = { title = g.key, points = pts, style = "linespoints" } end
 end
-page:plot("fig4.5-leak-vs-K", { title = "Umbra light leak against the filter width", subtitle = "overlap.lua",
+page:plot("fig4.5-leak-vs-K", { title = "Umbra light leak against the filter width", rows = used,
                                 xlabel = "K (texels)", ylabel = "mean umbra leak", series = series })
 page:table({ "technique", "K", "setting", "umbra leak", "penumbra over-dark", "RMSE" }, rows_table)
 
@@ -71,7 +74,7 @@ for _, f in ipairs({ 0.25, 0.5, 0.75 }) do
 end
 page:plot("fig4.5-closed-form", {
   title = "VSM's lit estimate behind two occluders (the truth is 0)",
-  subtitle = "catalogue §4.2.1 [OWN]: fraction f at z1, 1 - f at z2 = z1 + D, receiver at d; D = 1",
+  analytic = "catalogue §4.2.1 [OWN]: fraction f at z1, 1 - f at z2 = z1 + D, receiver at d; D = 1",
   xlabel = "(d - z2) / D", ylabel = "p = f(1-f)D^2 / (f(1-f)D^2 + (d - mu)^2)", series = closed,
 })
 page:write()

@@ -53,7 +53,7 @@ local page = figures.page(result.out, "Course Figs. 4.7 and 4.8: CSM ringing aga
   "reference, 0) where the reference is shadowed; lit over-darkening: mean of max(reference - estimate, 0) where " ..
   "it is lit. 'plain' is Eq. 4.6 as printed (scale 1, no damping, offset 0); 'fixed' the defaults (scale 2 and " ..
   "clamp, damping exp(-(k/M)^2)).")
-local pcf_leak, rows_table = 0, {}
+local pcf_leak, rows_table, used = 0, {}, {}
 local series = { leak = {}, dark = {} }
 for _, g in ipairs(figures.group(result, function(r)
   if r.technique == "pcf" then return "pcf" end
@@ -69,15 +69,16 @@ end, function(r) return r.params.terms or 0 end)) do
                                     string.format("%.4f", m.lit.dark_mean), string.format("%.4f", m.all.rmse),
                                     string.format("%.1f", 1e3 * r.record.timings_s.frame) }
   end
+  for _, r in ipairs(g.rows) do used[#used + 1] = r end
   if g.key ~= "pcf" then
     series.leak[#series.leak + 1] = { title = g.key, points = pts.leak, style = "linespoints" }
     series.dark[#series.dark + 1] = { title = g.key, points = pts.dark, style = "linespoints" }
   end
 end
 page:plot("fig4.7-umbra-leak", { title = "CSM: light rung into the umbra against M", hline = pcf_leak,
-                                 subtitle = "cube-top; dashed: pcf K = 5", xlabel = "terms M (log scale)",
+                                 rows = used, subtitle = "dashed: pcf K = 5", xlabel = "terms M (log scale)",
                                  ylabel = "mean umbra leak", logx = true, series = series.leak })
-page:plot("fig4.7-lit-dark", { title = "CSM: lit surfaces darkened against M", subtitle = "cube-top",
+page:plot("fig4.7-lit-dark", { title = "CSM: lit surfaces darkened against M", rows = used,
                                xlabel = "terms M (log scale)", ylabel = "mean lit over-darkening", logx = true,
                                series = series.dark })
 page:table({ "method", "M", "umbra leak", "lit over-dark", "RMSE", "frame ms" }, rows_table)
@@ -104,7 +105,7 @@ for _, v in ipairs({ { "plain", 0, 0, 1 }, { "damped a = 1", 1, 0, 1 }, { "dampe
   curves[#curves + 1] = { title = v[1], points = pts, style = "linespoints" }
 end
 page:plot("fig4.8-steps", { title = "Fig. 4.8: the step approximated by M = 8 Fourier terms",
-                            subtitle = "x = z - d; lit where x > 0", xlabel = "z - d (normalised depth)",
+                            analytic = "Eq. 4.6, x = z - d; lit where x > 0", xlabel = "z - d (normalised depth)",
                             ylabel = "approximated step", series = curves })
 local gibbs = {}
 for _, M in ipairs({ 2, 4, 8, 16, 32 }) do

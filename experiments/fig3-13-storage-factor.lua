@@ -69,7 +69,8 @@ for _, light in ipairs(LIGHTS) do
     fp_text[#fp_text + 1] = string.format("%s: %d maps, %.4g", s[1], faces, fr.storage_factor)
   end
   plot.draw(out .. "/plots", light.name, { title = "Course Fig. 3.13: storage factor, " .. light.label,
-    subtitle = "Lloyd's measure over the view frustum, z_f / z_n = 100", xlabel = "number of shadow maps",
+    scene = lab:info(), no_reference = "Lloyd's measure over the view frustum, z_f / z_n = 100",
+    xlabel = "number of shadow maps",
     ylabel = "storage factor", series = series, logy = true })
   md[#md + 1] = "## " .. light.label
   md[#md + 1] = ""

@@ -11,9 +11,13 @@
 --  1. For the small light (radius 0.1), which K gives the lowest penumbra
 --     RMSE? For the large light (0.4)? Why does the best K grow with the
 --     light, and why is a fixed K wrong for both at once?
---  2. The shadow map is built once per light size: find in records.jsonl that
---     every K reuses it ("action": "reused"). Why does the frame time still
---     count its build time (see the definition in the report)?
+--  2. The shadow map is built once for both light sizes: it is rendered
+--     from the light's centre, so its key ignores the radius. Find in
+--     records.jsonl that only a technique's first configuration builds it
+--     and every other K, on either radius, reuses it ("action": "reused").
+--     Why does the frame time still count its build time (see the definition
+--     in the report)? What does it tell you about how much PCF knows of the
+--     light's size?
 --  3. How does the cost grow with K for the box kernel (cost-vs-K plot)?
 --     Explain the shape from the number of depth comparisons per pixel.
 --  4. Look at the signed-error images for the largest K: where does PCF leak

@@ -79,7 +79,7 @@ local TECHS = {
   { name = "single_sample_rt", label = "single_sample_rt tessellated", params = { analytic_spheres = false } },
 }
 
-local csv, series = { "set,radius,technique,rho" }, {}
+local csv, series, runs = { "set,radius,technique,rho" }, {}, {}
 for _, set in ipairs(SETS) do
   for _, tech in ipairs(TECHS) do
     local points = {}
@@ -90,6 +90,7 @@ for _, set in ipairs(SETS) do
       local lab = sl.open(set.file, overrides)
       local run = lab:compare{ technique = tech.name, params = tech.params, samples = exp.samples, cache = exp.cache }
       local rho = relative_error(run)
+      runs[#runs + 1] = run:record()
       lab:close()
       csv[#csv + 1] = string.format("%s,%g,%s,%.6g", set.label, radius, tech.label, rho)
       points[#points + 1] = { radius, rho }
@@ -102,8 +103,7 @@ end
 sl.write_file(result.out .. "/relative_error.csv", table.concat(csv, "\n") .. "\n")
 plot.draw(result.out .. "/plots", "relative-error", {
   title = "Seed 002: error in units of the shadow's darkness, sum|e| / sum(1 - V_ref)",
-  subtitle = string.format("320x240, reference %d samples; single_sample_rt at its defaults (min, analytic spheres)",
-                           exp.samples),
+  rows = runs, subtitle = "single_sample_rt at its defaults (min, analytic spheres)",
   xlabel = "light radius (world units)", ylabel = "rho", series = series, logx = true,
 })
 io.stderr:write(table.concat(csv, "\n") .. "\n")

@@ -70,7 +70,7 @@ local md = { "# Hard-shadow error against frame time on the terrain", "",
              "`sm` (nearest lookups, default biases) against the ray-traced truth; misclassified = share of the " ..
              "lit candidates whose shadow state is wrong; frame = the maps rebuilt + the lookups.", "",
              "| map size | configuration | maps | misclassified | frame (s) |", "|---:|---|---:|---:|---:|" }
-local by_size = {}
+local by_size, rows_of_size = {}, {}
 for _, r in ipairs(rows) do
   local m, t = r.record.metrics.all.misclassified, r.record.timings_s
   local maps = r.params.cascades
@@ -78,6 +78,8 @@ for _, r in ipairs(rows) do
                                 t.evaluate_median)
   md[#md + 1] = string.format("| %d | %s | %d | %.3f %% | %.3f |", r.size, label(r), maps, 100 * m, t.frame)
   by_size[r.size] = by_size[r.size] or {}
+  rows_of_size[r.size] = rows_of_size[r.size] or {}
+  table.insert(rows_of_size[r.size], r)
   local key = r.group == "pssm" and string.format("PSSM lambda=%g", r.params.split_lambda) or label(r)
   by_size[r.size][key] = by_size[r.size][key] or {}
   table.insert(by_size[r.size][key], { t.frame, 100 * m })
@@ -91,7 +93,8 @@ for size, groups in pairs(by_size) do
     series[#series + 1] = { title = k, points = groups[k], style = k:match("PSSM") and "linespoints" or "points" }
   end
   plot.draw(out .. "/plots", "error-vs-time-" .. size, { title = string.format("Terrain: error against time, %d^2 per map", size),
-    subtitle = "PSSM: m = 1..8 along each line", xlabel = "frame time (s)", ylabel = "misclassified (% of lit candidates)",
+    rows = rows_of_size[size], subtitle = "PSSM: m = 1..8 along each line", xlabel = "frame time (s)",
+    ylabel = "misclassified (% of lit candidates)",
     series = series, logx = true })
   md[#md + 1] = ""
   md[#md + 1] = string.format("![%d](plots/error-vs-time-%d.svg)", size, size)

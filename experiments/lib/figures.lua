@@ -2,7 +2,9 @@
 -- filtered-error-vs-time.lua) add to the standard report: curve plots of
 -- quantities the report does not plot (acne and leak fractions, umbra areas,
 -- 1-D step approximations), tables, and one figure.html per experiment
--- beside the report's index.html. Loaded with
+-- beside the report's index.html. A plot's spec takes the rows it shows
+-- (spec.rows: plot.lua states their scene, resolution, reference samples and
+-- noise) or, for closed-form curves, spec.analytic. Loaded with
 --   local figures = dofile(sl.root .. "/experiments/lib/figures.lua")
 local sl = require "shadowlab"
 local plot = require "shadowlab.plot"

@@ -2,10 +2,10 @@
 -- techniques x parameter points, from the registry), a stable key for each
 -- (the engine's hash of the scene's content, light, technique and every
 -- parameter value), one Lab per scene variant so a technique's resources are
--- reused across its parameter points (and dropped before the next technique,
--- so memory stays bounded), a warm-up and N timed repeats per configuration
--- (stopping early past a time budget), and
--- one record row each, appended durably (records.lua). --resume skips keys
+-- reused across its parameter points (and dropped before the next technique
+-- or once they pass resource_budget_gib, so memory stays bounded), a warm-up
+-- and N timed repeats per configuration (stopping early past a time budget),
+-- and one record row each, appended durably (records.lua). --resume skips keys
 -- already recorded; --shard I/N runs the configurations whose index modulo N
 -- is I into their own files, for `shadowlab merge`.
 local sl = package.loaded.shadowlab or require "shadowlab"
@@ -19,11 +19,16 @@ Experiment.__index = Experiment
 -- time_budget_s: the timed repeats of a configuration stop once they took
 -- this long (at least one runs; lab.h RenderTiming), so a slow technique
 -- does not hold a sweep up for `repeats` long evaluations; 0: no limit.
+-- resource_budget_gib: once the resources held reach this, they are dropped
+-- before the next configuration (a technique's points keep what they share,
+-- but each of csm's term counts holds GiB of moments that no other uses).
+-- It changes what is rebuilt, not the results: frame time counts a
+-- resource's build time whether this run built or reused it.
 local defaults = { samples = 256, pattern = "r2", seed = 1, light = 1, repeats = 3, warmup = 1, images = true,
-                   exr = false, time_budget_s = 1 }
+                   exr = false, time_budget_s = 1, resource_budget_gib = 2 }
 local spec_fields = { name = true, scenes = true, overrides = true, samples = true, pattern = true, seed = true,
                       light = true, repeats = true, warmup = true, images = true, exr = true, cache = true,
-                      description = true, time_budget_s = true }
+                      description = true, time_budget_s = true, resource_budget_gib = true }
 
 local function merged(a, b)
   local m = {}
@@ -120,7 +125,9 @@ experiment options:
   --samples N      reference light samples per view sample
   -s, --set K=V    scene override for every scene, e.g. --set camera.width=160 (repeatable)
   --no-images      no PNG images per configuration (smaller, faster; the report shows plots only)
-  --quiet          no progress lines]]
+  --quiet          no progress lines
+  -h, --help       this list (and the script's own options)]]
+experiment.usage = usage -- `shadowlab run --help` prints it
 
 local function extra_usage(extra)
   local names, lines = {}, {}
@@ -191,7 +198,8 @@ end
 
 ---------------------------------------------------------------- configurations
 
-local function technique_handles(desc, light_type)
+-- Does the technique (a registry description) handle lights of this type?
+function experiment.handles(desc, light_type)
   for _, l in ipairs(desc.lights) do
     if l == light_type then return true end
   end
@@ -220,7 +228,7 @@ function Experiment:configurations()
   for _, e in ipairs(self.entries) do
     for vi, v in ipairs(self.variants) do
       local light = v.info.lights[self.light]
-      local key = technique_handles(e.technique, light.type) and v.lab:key(e.technique.name, e.params, self.light)
+      local key = experiment.handles(e.technique, light.type) and v.lab:key(e.technique.name, e.params, self.light)
       if key and not seen[key] then
         seen[key] = true
         configs[#configs + 1] = { index = #configs, variant = v, variant_index = vi, entry = e, key = key,
@@ -386,6 +394,8 @@ function Experiment:run(argv)
     if row then
       result.skipped = result.skipped + 1
     else
+      local held = c.variant.lab:info().resource_bytes
+      if held >= self.resource_budget_gib * 2 ^ 30 then c.variant.lab:drop_resources() end
       row = self:run_one(c, o, header)
       writer:append(row)
       result.computed = result.computed + 1

@@ -21,7 +21,7 @@ th { background: #f3f3f3; } td.n { text-align: right; font-variant-numeric: tabu
 tr.front td { background: #eef7ee; } tr.err td { background: #fbeaea; }
 .plots { display: grid; grid-template-columns: repeat(auto-fill, minmax(480px, 1fr)); gap: 8px; }
 .plots img { width: 100%; border: 1px solid #eee; }
-.grid { display: grid; grid-template-columns: repeat(auto-fill, minmax(220px, 1fr)); gap: 10px; }
+.grid { display: grid; grid-template-columns: repeat(3, minmax(0, 1fr)); gap: 10px; }
 .grid figure { margin: 0; font-size: 11px; } .grid img { width: 100%; image-rendering: pixelated; }
 .ref { outline: 3px solid #444; } #load-status { font-weight: bold; } .note { color: #555; }
 ]]
@@ -90,19 +90,23 @@ local function figure(src, caption, class)
                        esc(caption), class and ' class="' .. class .. '"' or "", caption)
 end
 
--- The images of one scene variant: the reference first, then every
--- configuration's visibility and signed error.
+-- The images of one scene variant: the reference first (shaded and
+-- visibility), then every configuration's shaded image, visibility and
+-- signed error, three to a row.
 local function image_grid(entry, doc, out)
   local first
   for _, r in ipairs(entry.rows) do first = first or (r.images and r) end
   if not first then return end
   out[#out + 1] = '<div class="grid">'
-  out[#out + 1] = figure(first.images.reference, "reference (" .. esc(first.record.reference.samples) ..
-                         " samples)", "ref")
   out[#out + 1] = figure(first.images.reference_shaded, "reference, shaded", "ref")
+  out[#out + 1] = figure(first.images.reference, "reference visibility (" ..
+                         esc(first.record.reference.samples) .. " samples)", "ref")
+  out[#out + 1] = '<p class="note">Each configuration below: shaded, visibility, signed error (estimate - ' ..
+                  "reference; blue too dark, red leaking).</p>"
   for _, r in ipairs(entry.rows) do
     if r.images then -- rows resumed from a run with --no-images have none
       local cap = esc(r.label) .. ": " .. esc(doc.err_label) .. " " .. num(doc.err(r), "%.4f")
+      out[#out + 1] = figure(r.images.shaded, esc(r.label) .. ": shaded")
       out[#out + 1] = figure(r.images.visibility, cap)
       out[#out + 1] = figure(r.images.error, esc(r.label) .. ": signed error, ±" ..
                              num(r.record.metrics.error_png_scale, "%g") .. " (blue too dark, red leaking)")

@@ -14,22 +14,25 @@ local merge = {}
 local usage = "usage: shadowlab merge [-o OUT] [--force] DIR...\n" ..
               "  merges the records*.jsonl of the shard folders DIR... into OUT (default: the first DIR)\n"
 
-local function fail(msg) error({ message = msg }, 0) end
+-- A refusal exits 1; a usage error (bad option, missing value or DIR) exits 2.
+local function fail(msg) error({ message = msg, status = 1 }, 0) end
+local function usage_fail(msg) error({ message = msg, status = 2 }, 0) end
 
 local function parse(argv)
   local o, i = { dirs = {} }, 1
   while argv[i] do
     local a = argv[i]
     if a == "-o" or a == "--out" then
-      o.out = argv[i + 1] or fail("-o expects a folder")
+      o.out = argv[i + 1]
+      if not o.out or o.out:sub(1, 1) == "-" then usage_fail(a .. " expects a folder") end
       i = i + 1
     elseif a == "--force" then o.force = true
     elseif a == "--help" or a == "-h" then o.help = true
-    elseif a:sub(1, 1) == "-" then fail("unknown option '" .. a .. "'")
+    elseif a:sub(1, 1) == "-" then usage_fail("unknown option '" .. a .. "'")
     else o.dirs[#o.dirs + 1] = (a:gsub("/+$", "")) end
     i = i + 1
   end
-  if not o.help and #o.dirs == 0 then fail("no DIR given") end
+  if not o.help and #o.dirs == 0 then usage_fail("no DIR given") end
   o.out = o.out and o.out:gsub("/+$", "") or o.dirs[1]
   return o
 end
@@ -159,9 +162,8 @@ function merge.main(...)
   local ok, result = pcall(run, { ... })
   if ok then return result end
   if type(result) == "table" and result.message then
-    io.stderr:write("shadowlab merge: ", result.message, "\n")
-    return result.message:match("^unknown option") or result.message:match("expects") or
-           result.message:match("^no DIR") and 2 or 1
+    io.stderr:write("shadowlab merge: ", result.message, "\n", result.status == 2 and usage or "")
+    return result.status
   end
   error(result, 0)
 end

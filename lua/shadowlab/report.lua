@@ -4,7 +4,7 @@
 -- reference, and gnuplot plots in SVG and PNG: error against time with the
 -- Pareto front marked, error against each swept parameter, cost against each
 -- swept parameter. Every plot names its scene, resolution, reference samples
--- and reference noise.
+-- and reference noise (plot.lua builds that from the rows it is given).
 local json = require "shadowlab.json"
 local pareto = require "shadowlab.pareto"
 local plot = require "shadowlab.plot"
@@ -48,25 +48,6 @@ local function group_by(rows, key_of)
     table.insert(groups[k], r)
   end
   return groups, order
-end
-
-local function range_text(values, fmt)
-  local lo, hi = math.huge, -math.huge
-  for _, v in ipairs(values) do lo, hi = math.min(lo, v), math.max(hi, v) end
-  if lo == hi then return string.format(fmt, lo) end
-  return string.format(fmt .. "-" .. fmt, lo, hi)
-end
-
--- "bunny 320x240, reference 256 samples, noise rms 0.0041" for a set of rows.
-local function caption(rows)
-  local rec = rows[1].record
-  local noise, samples = {}, {}
-  for _, r in ipairs(rows) do
-    noise[#noise + 1] = r.record.metrics.noise_rms
-    samples[#samples + 1] = r.record.reference.samples
-  end
-  return string.format("%s %dx%d, reference %s samples, noise rms %s", rec.scene.name, rec.scene.width,
-                       rec.scene.height, range_text(samples, "%d"), range_text(noise, "%.4f"))
 end
 
 local function slug(s) return (s:gsub("[^%w]+", "-"):gsub("^-+", ""):gsub("-+$", "")) end
@@ -190,7 +171,7 @@ local function error_vs_time(ctx, variant_rows, name)
   local noise = variant_rows[1].record.metrics.noise_rms
   return plot.draw(ctx.dir, "error-vs-time-" .. name, {
     title = ctx.err_label .. " against " .. time_fields[ctx.time],
-    subtitle = caption(variant_rows) .. "; dashed: reference noise",
+    rows = variant_rows, subtitle = "dashed: reference noise",
     xlabel = time_fields[ctx.time] .. " (ms, log scale)", ylabel = ctx.err_label, logx = true,
     series = series, hline = noise,
   })
@@ -215,7 +196,7 @@ local function along_axis(ctx, axis, scene_rows, name, what)
   local ylabel = what == "error" and ctx.err_label or time_fields[ctx.time] .. " (ms)"
   return plot.draw(ctx.dir, (what == "error" and "error-vs-" or "cost-vs-") .. slug(axis.name) .. "-" .. name, {
     title = (what == "error" and ctx.err_label or time_fields[ctx.time]) .. " against " .. axis.name,
-    subtitle = caption(scene_rows), xlabel = axis.name .. (logx and " (log scale)" or ""), ylabel = ylabel,
+    rows = scene_rows, xlabel = axis.name .. (logx and " (log scale)" or ""), ylabel = ylabel,
     logx = logx, series = series,
   })
 end

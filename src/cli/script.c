@@ -2,7 +2,8 @@
  * interpreter with the shadowlab module loaded (src/lua/), the project's lua/
  * folder on package.path, and `arg` set as lua5.4 sets it (arg[0] the
  * script, arg[1..] its arguments). A Lua error exits 1 with its message and
- * a traceback. The same interpreter runs the Lua side of `merge`. */
+ * a traceback; the script's result is its exit status (nil: 0). The same
+ * interpreter runs the Lua side of `merge`. */
 #include <lauxlib.h>
 #include <limits.h>
 #include <lualib.h>
@@ -47,8 +48,22 @@ static void set_args(lua_State *L, const char *script, int argc, char **argv)
     lua_setglobal(L, "arg");
 }
 
+/* The exit status a script's result gives: nil (no return) 0, an integer in
+ * [0, 255] itself; anything else (a string, a float, an integer a shell
+ * would wrap to 0) is a mistake, never success: it prints and gives 1. */
+static int exit_status_of(lua_State *L, const char *command)
+{
+    if (lua_isnoneornil(L, -1)) return EXIT_OK;
+    if (lua_isinteger(L, -1) && lua_tointeger(L, -1) >= 0 && lua_tointeger(L, -1) <= 255)
+        return (int)lua_tointeger(L, -1);
+    const char *what = luaL_tolstring(L, -1, NULL);
+    fprintf(stderr, "shadowlab %s: the script returned %s (a %s), not an exit status: nil or an integer in "
+                    "[0, 255]\n", command, what, luaL_typename(L, -2));
+    return EXIT_RUNTIME;
+}
+
 /* Call the function on top of the stack with `arg`'s elements; the exit
- * status is an integer it returns, else 0; errors print and give 1. */
+ * status comes from its result (exit_status_of); errors print and give 1. */
 static int call_main(lua_State *L, const char *command, int argc, char **argv)
 {
     int fn = lua_gettop(L);
@@ -60,13 +75,18 @@ static int call_main(lua_State *L, const char *command, int argc, char **argv)
         fprintf(stderr, "shadowlab %s: %s\n", command, lua_tostring(L, -1));
         return EXIT_RUNTIME;
     }
-    return lua_isinteger(L, -1) ? (int)lua_tointeger(L, -1) : EXIT_OK;
+    return exit_status_of(L, command);
 }
 
-static lua_State *open_state(void)
+/* A state with the standard libraries and shadowlab; NULL (said on stderr)
+ * when out of memory. */
+static lua_State *open_state(const char *command)
 {
     lua_State *L = luaL_newstate();
-    if (!L) return NULL;
+    if (!L) {
+        fprintf(stderr, "shadowlab %s: cannot create a Lua state (out of memory)\n", command);
+        return NULL;
+    }
     luaL_openlibs(L);
     set_project_root();
     luaL_requiref(L, "shadowlab", luaopen_shadowlab, 0);
@@ -76,11 +96,8 @@ static lua_State *open_state(void)
 
 int cli_lua_module_main(const char *command, const char *module, int argc, char **argv)
 {
-    lua_State *L = open_state();
-    if (!L) {
-        fprintf(stderr, "shadowlab %s: cannot create a Lua state (out of memory)\n", command);
-        return EXIT_RUNTIME;
-    }
+    lua_State *L = open_state(command);
+    if (!L) return EXIT_RUNTIME;
     set_args(L, command, argc, argv);
     lua_getglobal(L, "require");
     lua_pushstring(L, module);
@@ -101,17 +118,28 @@ static const char *const run_help =
     "usage: shadowlab run [--threads N] SCRIPT.lua [ARGS...]\n"
     "  runs a Lua 5.4 script with `require \"shadowlab\"` and the helpers in lua/shadowlab/\n"
     "  (sweep, experiment, records, report, pareto, autotune) available; ARGS are in `arg`.\n"
-    "  Experiments take: --out DIR --resume --fresh --shard I/N --threads N --repeats N\n"
-    "  --warmup N --samples N --no-images (see README, \"The Lua lab\").\n";
+    "  Scripts built on experiment:run take the options below (SCRIPT --help adds the script's\n"
+    "  own; see README, \"The Lua lab\").\n";
+
+/* run --help: the command, then the options of every experiment script,
+ * printed from lua/shadowlab/experiment.lua's own usage (the one list). */
+static int print_run_help(void)
+{
+    fputs(run_help, stdout);
+    lua_State *L = open_state("run");
+    if (!L) return EXIT_RUNTIME;
+    int status = luaL_dostring(L, "io.stdout:write(require('shadowlab.experiment').usage, '\\n')");
+    if (status != LUA_OK)
+        fprintf(stderr, "shadowlab run: cannot list the experiment options: %s\n", lua_tostring(L, -1));
+    lua_close(L);
+    return status == LUA_OK ? EXIT_OK : EXIT_RUNTIME;
+}
 
 int cmd_run(int argc, char **argv)
 {
     int i = 1, threads = 0;
     for (; i < argc && argv[i][0] == '-'; i++) {
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
-            fputs(run_help, stdout);
-            return EXIT_OK;
-        }
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) return print_run_help();
         char *end = NULL;
         long n = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : 0;
         if (strcmp(argv[i], "--threads") != 0 || !end || *end || n < 1 || n > 1024) {
@@ -128,11 +156,8 @@ int cmd_run(int argc, char **argv)
     }
     CliOptions o = {.threads = threads};
     cli_apply_threads(&o);
-    lua_State *L = open_state();
-    if (!L) {
-        fprintf(stderr, "shadowlab run: cannot create a Lua state (out of memory)\n");
-        return EXIT_RUNTIME;
-    }
+    lua_State *L = open_state("run");
+    if (!L) return EXIT_RUNTIME;
     const char *script = argv[i];
     set_args(L, script, argc - i - 1, argv + i + 1);
     int status;

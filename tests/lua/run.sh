@@ -1,10 +1,11 @@
 #!/bin/sh
 # run.sh -- the Lua lab's tests: the helpers' unit tests, the module from a
-# plain lua5.4, exit statuses and bad parameters, a sweep killed with SIGKILL
-# and resumed, the same sweep as 2 shards through GNU Parallel (and the Slurm
-# script) merged and compared with the unsharded run, merge refusals, the
-# shipped experiments at tiny sizes (error-vs-time's plot shows every
-# registered technique), and the report opened in headless Chromium.
+# plain lua5.4, exit statuses (a script's result, usage errors of run and
+# merge) and bad parameters, a sweep killed with SIGKILL and resumed, the
+# same sweep as 2 shards through GNU Parallel (and the Slurm script) merged
+# and compared with the unsharded run, merge refusals, the shipped
+# experiments at tiny sizes (error-vs-time's plots show every registered
+# technique), and the report opened in headless Chromium.
 # Usage: tests/lua/run.sh build/shadowlab.
 # Prints "lua: N passed, N failed".
 set -u
@@ -69,8 +70,15 @@ expect bad_param_refused_before_running 1 "offset_scale" "[0, 10000]" -- \
 if [ -e "$TMP/bad" ]; then no bad_param_writes_nothing "$TMP/bad exists"; else ok bad_param_writes_nothing; fi
 expect unknown_param_names_the_known_ones 1 "unknown parameter 'ofset_scale'" "offset_scale" -- \
     "$SL" run tests/lua/bad/unknown-param.lua
+expect script_result_is_the_exit_status 3 -- "$SL" run tests/lua/bad/returns.lua 3
+for kind in string float big; do
+    expect "script_returning_a_${kind}_fails" 1 "not an exit status" -- "$SL" run tests/lua/bad/returns.lua "$kind"
+done
+expect run_help_lists_every_experiment_option 0 --out --resume --fresh --shard --threads --repeats --warmup \
+    --samples --set --no-images --quiet -- "$SL" run --help
 expect experiment_unknown_argument 2 "unknown argument '--frob'" -- "$SL" run "$SWEEP" --frob
 expect experiment_bad_shard 2 "--shard expects I/N" -- "$SL" run "$SWEEP" --shard 2/2
+expect nonfinite_params_refused_from_lua 0 "refusals checked" -- "$SL" run tests/lua/nonfinite-params.lua
 
 # ---- the unsharded sweep (with images: the browser test opens its report)
 FULL=$TMP/full
@@ -85,6 +93,9 @@ for f in index.html plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg 
          plots/cost-vs-lights-1-radius-sphere-on-plane.png; do
     [ -s "$FULL/$f" ] && ok "report_wrote_$(basename "$f")" || no "report_wrote_$(basename "$f")" "missing"
 done
+shaded=$(grep -o 'src="images/[0-9a-f]*/hard-shaded.png"' "$FULL/index.html" | sort -u | wc -l)
+[ "$shaded" -eq 6 ] && ok report_shows_each_configurations_shaded_image ||
+    no report_shows_each_configurations_shaded_image "$shaded of 6"
 if grep -q "reference 16 samples, noise rms" "$FULL/plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg" &&
    grep -q "64x48" "$FULL/plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg"; then
     ok plot_states_scene_resolution_samples_noise
@@ -130,7 +141,12 @@ done
 expect slurm_shards_merge 0 "6 of 6" -- "$SL" merge -o "$SLURM" "$SLURM"/shards/*
 same slurm_equals_unsharded "$SLURM/records.jsonl" "$FULL/records.jsonl"
 
-# ---- merge refusals
+# ---- merge usage errors (exit 2 with the usage) and refusals (exit 1)
+expect merge_unknown_option 2 "unknown option '--frob'" "usage: shadowlab merge" -- "$SL" merge --frob "$FULL"
+expect merge_o_needs_a_folder 2 "-o expects a folder" "usage: shadowlab merge" -- "$SL" merge -o
+expect merge_o_then_an_option 2 "-o expects a folder" -- "$SL" merge -o --force "$FULL"
+expect merge_needs_a_dir 2 "no DIR given" -- "$SL" merge -o "$TMP/nodir"
+expect merge_missing_dir 1 "$TMP/absent" -- "$SL" merge -o "$TMP/m" "$TMP/absent"
 expect merge_refuses_duplicates 1 "refusing duplicates" -- "$SL" merge -o "$TMP/dup" "$FULL" "$PAR/shards/0"
 "$SL" run "$SWEEP" --out "$TMP/other" --shard 0/2 --samples 8 --quiet --no-images >/dev/null 2>&1
 expect merge_refuses_mismatched_experiments 1 "refusing to merge different experiments" -- \

@@ -1,5 +1,5 @@
 -- test_helpers.lua -- tests of the pure-Lua helpers (json, sweep, pareto,
--- records, experiment, autotune) and of the module's refusals, run by
+-- records, experiment, autotune, plot) and of the module's refusals, run by
 -- `shadowlab run`. Prints "ok NAME" or "FAIL NAME: why" per test; the exit
 -- status is the number of failures (tests/lua/run.sh counts the lines).
 local sl = require "shadowlab"
@@ -233,6 +233,26 @@ test("experiment_runs_a_configuration_listed_twice_once", function()
   assert(#r.rows == 2 and r.computed == 2, "rows " .. #r.rows)
 end)
 
+test("experiment_drops_resources_past_its_memory_budget", function()
+  local function map_actions(budget)
+    local e = experiment.new{ name = "budget", samples = 4, repeats = 1, warmup = 0, overrides = small,
+                              resource_budget_gib = budget }
+    e:scene("scenes/sphere-on-plane.lua")
+    e:add("pcf", { { K = 1 }, { K = 3 } })
+    local r = e:run({ "--out", tmp .. "/budget-" .. budget, "--no-images", "--quiet" })
+    local actions = {}
+    for i, row in ipairs(r.rows) do
+      for _, ev in ipairs(row.record.technique_resources) do
+        if ev.kind == "shadow_map" then actions[i] = ev.action end
+      end
+    end
+    return table.concat(actions, " ")
+  end
+  local within, past = map_actions(2), map_actions(0)
+  assert(within == "built reused", "within the budget the second K reuses the map: " .. within)
+  assert(past == "built built", "past it every configuration starts afresh: " .. past)
+end)
+
 test("autotune_returns_the_best_feasible_point_it_evaluated", function()
   local lab = sl.open("scenes/sphere-on-plane.lua", small)
   local r = autotune.run{ lab = lab, technique = "hard", budget_s = 1e3, evaluations = 6, initial = 3, samples = 8,
@@ -248,6 +268,54 @@ test("autotune_returns_the_best_feasible_point_it_evaluated", function()
   assert(not none.feasible, "nothing fits a zero budget")
   for _, p in ipairs(none.history) do assert(p.time >= none.best.time, "infeasible: the fastest is reported") end
   lab:close()
+end)
+
+---------------------------------------------------------------- plots
+
+local function fake_row(scene, samples, noise)
+  return { record = { scene = { name = scene, width = 40, height = 30 }, reference = { samples = samples },
+                      metrics = { noise_rms = noise } } }
+end
+
+local function read_all(path)
+  local f = io.open(path, "rb")
+  if not f then return nil end
+  local text = f:read("a")
+  f:close()
+  return text
+end
+
+test("plot_subtitles_state_scene_resolution_samples_and_noise_from_the_rows", function()
+  local plot = require "shadowlab.plot"
+  local rows = { fake_row("ball", 64, 0.002), fake_row("ball", 64, 0.004), fake_row("box", 16, 0.01) }
+  assert(plot.caption(rows) == "ball 40x30, reference 64 samples, noise rms 0.0020-0.0040; " ..
+                               "box 40x30, reference 16 samples, noise rms 0.0100", plot.caption(rows))
+  local series = { { title = "a", points = { { 1, 1 }, { 2, 3 } } } }
+  plot.draw(tmp .. "/plots", "cap", { title = "T", subtitle = "extra", xlabel = "x", ylabel = "y", series = series,
+                                      rows = rows })
+  local gp = read_all(tmp .. "/plots/cap.gp")
+  assert(gp:find("\\nball 40x30, reference 64 samples", 1, true) and gp:find("\\nbox 40x30", 1, true) and
+         gp:find("\\nextra", 1, true), "subtitle")
+  expect_error(function() plot.draw(tmp .. "/plots", "bare", { title = "T", xlabel = "x", ylabel = "y",
+                                                               series = series }) end, "spec.rows")
+  plot.draw(tmp .. "/plots", "closed", { title = "T", xlabel = "x", ylabel = "y", series = series,
+                                         analytic = "y = x^2" })
+  assert(read_all(tmp .. "/plots/closed.gp"):find("closed form: y = x^2", 1, true))
+end)
+
+test("plot_images_appear_whole_or_not_at_all", function()
+  local plot = require "shadowlab.plot"
+  local dir = tmp .. "/atomic"
+  local spec = { title = "T", xlabel = "x", ylabel = "y", rows = { fake_row("ball", 8, 0.1) },
+                 series = { { title = "a", points = { { 1, 1 }, { 2, 3 } } } } }
+  plot.draw(dir, "p", spec)
+  local svg, png = read_all(dir .. "/p.svg"), read_all(dir .. "/p.png")
+  assert(svg and svg:find("</svg>", 1, true) and png and #png > 100, "both images written whole")
+  -- gnuplot failing half-way (no valid point to plot) leaves the old images as they were, and no temporary
+  spec.series = { { title = "a", points = {} } }
+  expect_error(function() plot.draw(dir, "p", spec) end, "gnuplot failed")
+  assert(read_all(dir .. "/p.svg") == svg and read_all(dir .. "/p.png") == png, "old images untouched")
+  for _, name in ipairs(sl.dir(dir)) do assert(not name:find("partial", 1, true), "left behind: " .. name) end
 end)
 
 for _, t in ipairs(tests) do
