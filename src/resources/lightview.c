@@ -49,24 +49,65 @@ static double split_at(SplitScheme s, double lambda, int i, int m, double zn, do
     return lambda * lg + (1.0 - lambda) * un; /* Zhang et al. 2006a, the practical split scheme */
 }
 
-/* With a pseudo-near plane z_p (Lloyd 2007 §5.1.8) the first slice is
- * [z_n, z_p] and the scheme splits [z_p, z_f] into the other m - 1. */
-void lightview_splits(SplitScheme scheme, double lambda, int m, double z_n, double z_f, double pseudo_near,
-                      double *split)
+/* The view depths the splits divide: z_n kept above 1e-9 z_f, since
+ * C_i = z_n r^(i/m) divides by z_n. */
+static void split_range(double *z_n, double *z_f)
 {
-    z_f = fmax(z_f, z_n);
-    z_n = fmax(z_n, 1e-9 * z_f); /* C_i = z_n r^(i/m) divides by z_n */
-    if (!(z_f > z_n)) z_f = z_n * (1.0 + 1e-9) + 1e-300;
-    int first = 0;
-    double lo = z_n;
+    *z_f = fmax(*z_f, *z_n);
+    *z_n = fmax(*z_n, 1e-9 * *z_f);
+    if (!(*z_f > *z_n)) *z_f = *z_n * (1.0 + 1e-9) + 1e-300;
+}
+
+/* With a pseudo-near plane z_p (Lloyd 2007 §5.1.8) the first slice is
+ * [z_n, z_p] and the scheme splits [z_p, z_f] into the other m - 1;
+ * explicit distances are used as given. */
+void lightview_splits(const LightViewParams *lp, int m, double z_n, double z_f, double *split)
+{
+    split_range(&z_n, &z_f);
     split[0] = z_n;
+    split[m] = z_f;
+    if (lp->split == SPLIT_EXPLICIT) {
+        for (int i = 1; i < m; i++) split[i] = lp->split_at[i - 1];
+        return;
+    }
+    int first = 0;
+    double lo = z_n, pseudo_near = lp->pseudo_near;
     if (pseudo_near > z_n && pseudo_near < z_f && m >= 2) {
         split[1] = pseudo_near;
         first = 1;
         lo = pseudo_near;
     }
-    for (int i = first + 1; i < m; i++) split[i] = split_at(scheme, lambda, i - first, m - first, lo, z_f);
-    split[m] = z_f;
+    for (int i = first + 1; i < m; i++)
+        split[i] = split_at(lp->split, lp->split_lambda, i - first, m - first, lo, z_f);
+}
+
+bool lightview_check_splits(const LightViewParams *lp, int m, double z_n, double z_f, const char *far_what,
+                            Error *err)
+{
+    const int n = LIGHTVIEW_EXPLICIT_SPLITS;
+    if (lp->split != SPLIT_EXPLICIT) return true;
+    if (m - 1 > n)
+        return error_set(err, "cascades %d with split_scheme explicit: only split_1..split_%d can be given, so "
+                              "cascades in [1, %d]", m, n, n + 1);
+    for (int k = 0; k < n; k++) {
+        bool used = k < m - 1;
+        if (used && !(lp->split_at[k] > 0.0))
+            return error_set(err, "cascades %d with split_scheme explicit takes split_1..split_%d; split_%d is not "
+                                  "given (0)", m, m - 1, k + 1);
+        if (!used && lp->split_at[k] != 0.0)
+            return error_set(err, "split_%d = %g is given, but cascades %d with split_scheme explicit takes %d split "
+                                  "distance(s): set cascades %d, or split_%d = 0", k + 1, lp->split_at[k], m, m - 1,
+                             k + 2, k + 1);
+    }
+    split_range(&z_n, &z_f);
+    for (int k = 0; k < m - 1; k++) {
+        double c = lp->split_at[k], lo = k > 0 ? lp->split_at[k - 1] : z_n;
+        if (!(c > lo && c < z_f))
+            return error_set(err, "split_%d = %g outside (%g, %g): explicit split distances are view depths in world "
+                                  "units, increasing, inside the view's (z_n, z_f) = (%g, %g) (z_f: %s)",
+                             k + 1, c, lo, z_f, z_n, z_f, far_what);
+    }
+    return true;
 }
 
 /* ---- the target ------------------------------------------------------------- */
@@ -78,6 +119,8 @@ typedef struct Target {
     double extent;   /* scene diagonal */
     double z_min, z_max; /* view-depth range of the points (warps), within the camera's */
 } Target;
+
+static dvec3 bounds_centre(const Target *t) { return d3_scale(d3_add(t->bounds[0], t->bounds[7]), 0.5); }
 
 static void box_corners(vec3 lo, vec3 hi, dvec3 *out)
 {
@@ -196,7 +239,7 @@ typedef struct FaceOpts {
     bool aligned;   /* the light view's y axis follows `up` (the view direction), not a world axis */
     dvec3 up;
     bool square;    /* equal extents (a warp's base: its plane stays isotropic) */
-    bool stabilize; /* texel-snapped on a ladder of sizes (ortho) */
+    bool stabilize; /* world-fixed orientation, texel-snapped on a ladder of sizes (unwarped faces) */
 } FaceOpts;
 
 static dvec3 face_up(const FaceOpts *o, dvec3 axis) { return o->aligned ? o->up : any_up(axis); }
@@ -221,13 +264,15 @@ static void make_square(double ext[4])
 
 /* Course §3.2.1: a constant orientation (the light view's axes are world-
  * fixed, face_up) and texel-sized steps: the width is rounded up to a
- * ladder 2^(k/4) of the scene's extent and the window's corner snapped to
- * whole texels, so the texel grid stays put in world space while the body
- * moves (it only jumps when the body outgrows a rung). */
-static void stabilize_extents(double ext[4], int res, double extent)
+ * ladder 2^(k/4) of `unit` and the window's corner snapped to whole texels,
+ * so the texel grid stays put in world space while the body moves (it only
+ * jumps when the body outgrows a rung). Ortho windows are in world units
+ * (unit: the scene's extent); perspective ones in tangents at unit depth
+ * (unit 1), where a fixed window is a fixed bundle of rays from the light. */
+static void stabilize_extents(double ext[4], int res, double unit)
 {
     double need = fmax(ext[1] - ext[0], ext[3] - ext[2]);
-    double k = ceil(4.0 * log2(fmax(need, 1e-300) / extent)), size = extent * exp2(k / 4.0);
+    double k = ceil(4.0 * log2(fmax(need, 1e-300) / unit)), size = unit * exp2(k / 4.0);
     while (size < need + 2.0 * (LIGHTVIEW_MARGIN_TEXELS + 1.0) * size / res) size *= exp2(0.25);
     double texel = size / res;
     for (int a = 0; a < 2; a++) {
@@ -286,8 +331,9 @@ static bool fit_perspective(MapFace *f, int res, const Light *light, MapFit fit,
         max_tan = fmin(max_tan, tan(light->cone_half_rad));
     } else if (light->kind == LIGHT_RECT || light->kind == LIGHT_DISK || light->kind == LIGHT_TEXTURED_RECT) {
         axis = d3_from(light->direction);
-    } else {
-        axis = d3_normalize_or(d3_sub(centroid(tg->pts, tg->n), eye), d3(0, -1, 0));
+    } else { /* point, sphere: toward the target, or the scene's centre when the orientation must stay fixed */
+        dvec3 aim = o->stabilize ? bounds_centre(tg) : centroid(tg->pts, tg->n);
+        axis = d3_normalize_or(d3_sub(aim, eye), d3(0, -1, 0));
     }
     dvec3 up = face_up(o, axis);
     mat4 view = m4_look(eye, axis, up);
@@ -303,8 +349,12 @@ static bool fit_perspective(MapFace *f, int res, const Light *light, MapFit fit,
         dmax = dbound;
     }
     double far = fmax(dmax, 1e-6 * tg->extent) * 1.01;
-    pad(&ext[0], &ext[1], res, 1e-6);
-    pad(&ext[2], &ext[3], res, 1e-6);
+    if (o->stabilize) {
+        stabilize_extents(ext, res, 1.0);
+    } else {
+        pad(&ext[0], &ext[1], res, 1e-6);
+        pad(&ext[2], &ext[3], res, 1e-6);
+    }
     if (o->square) make_square(ext);
     return face_perspective(f, eye, axis, up, ext, near_plane(&view, tg->bounds, far), far, err);
 }
@@ -313,7 +363,7 @@ static bool fit_ortho(MapFace *f, int res, const Light *light, MapFit fit, const
                       Error *err)
 {
     dvec3 axis = d3_from(light->direction);
-    dvec3 centre = d3_scale(d3_add(tg->bounds[0], tg->bounds[7]), 0.5);
+    dvec3 centre = bounds_centre(tg);
     double radius = 0.5 * d3_len(d3_sub(tg->bounds[7], tg->bounds[0]));
     dvec3 eye = d3_madd(centre, axis, -2.0 * fmax(radius, 1e-30)); /* outside the scene, looking in */
     dvec3 up = face_up(o, axis);
@@ -425,8 +475,8 @@ static bool fit_face_along(LightView *lv, int index, const FitJob *j, const Targ
     bool directional = j->light->kind == LIGHT_DIRECTIONAL;
     MapProjection projection = proj != MAP_PROJ_AUTO ? proj : j->projection;
     bool warp = is_warp(projection);
-    /* stabilisation is for uniform maps of directional lights; elsewhere it has no effect */
-    bool stable = j->params->stabilize && directional && !warp;
+    /* stabilisation holds the unwarped faces still (ortho and perspective); a warp follows the view */
+    bool stable = j->params->stabilize && !warp;
     FaceOpts o = {.aligned = !stable && (warp || is_body(j->fit) || j->params->cascades > 1),
                   .up = j->view->fwd, .square = warp, .stabilize = stable};
     MapFace *f = &lv->face[index];
@@ -543,7 +593,7 @@ static bool fit_cascades(LightView *lv, const FitJob *j, const ViewSamples *vs, 
     const LightViewParams *lp = j->params;
     MapFit fit = j->fit == MAP_FIT_VIEW ? MAP_FIT_VIEW : MAP_FIT_BODY;
     int m = lp->cascades > 1 ? lp->cascades : 1;
-    lightview_splits(lp->split, lp->split_lambda, m, z_n, z_f, lp->pseudo_near, lv->split);
+    lightview_splits(lp, m, z_n, z_f, lv->split);
     lv->num_cascades = m;
     lv->num_faces = m;
     lv->view_eye = j->view->eye;
@@ -571,6 +621,10 @@ bool lightview_fit_with(const Scene *scene, const Light *light, MapProjection pr
     ViewFrustum vf = view_frustum(&scene->camera);
     double z_f = fit == MAP_FIT_BODY_VISIBLE ? visible_far(vs, vf.near, vf.far) : vf.far;
     vf.far = z_f;
+    const char *far_what = fit == MAP_FIT_BODY_VISIBLE ? "the farthest visible sample, fit=body_visible"
+                                                       : "the camera's far plane";
+    int m = lp.cascades > 1 ? lp.cascades : 1;
+    if (lp.split != SPLIT_FACES && !lightview_check_splits(&lp, m, vf.near, z_f, far_what, err)) return false;
     lv->res = res;
     lv->origin_world = d3_from(light->position);
     lv->light_dir = d3_normalize_or(d3_from(light->direction), d3(0, -1, 0));

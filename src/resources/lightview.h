@@ -60,9 +60,13 @@ typedef enum SplitScheme {
     SPLIT_PRACTICAL, /* Zhang et al. 2006: lambda log + (1 - lambda) uniform */
     SPLIT_LOG,       /* Lloyd et al. 2006: C_i = z_n (z_f / z_n)^(i / m) */
     SPLIT_UNIFORM,   /* C_i = z_n + (z_f - z_n) i / m */
+    SPLIT_EXPLICIT,  /* C_1..C_(m-1) given as view depths (LightViewParams.split_at, world units) */
     SPLIT_FACES,     /* frustum-face partitioning (course §3.2.3.2): one map per light-facing frustum face */
 } SplitScheme;
-#define SPLIT_SCHEME_NAMES "practical", "log", "uniform", "faces"
+#define SPLIT_SCHEME_NAMES "practical", "log", "uniform", "explicit", "faces"
+/* Interior split distances a map can be given (SPLIT_EXPLICIT): so at most
+ * this many + 1 explicit cascades, the usual 4 of the literature. */
+#define LIGHTVIEW_EXPLICIT_SPLITS 3
 
 /* Which cascade a point uses (course §3.2.3.1). */
 typedef enum CascadeSelect {
@@ -77,6 +81,7 @@ typedef enum CascadeSelect {
  * is a valid choice (it means the defaults). Lengths in world units. */
 typedef struct LightViewParams {
     double warp_n;        /* perspective warps: n as a multiple of the falloff's n (0: 1, i.e. n_opt) */
+    double warp_n_world;  /* lispsm, logpsm: a free n in world units (course Fig. 3.6), no falloff (0: off) */
     WarpFalloff falloff;
     double pseudo_near;   /* Lloyd 2007 §5.1.8-5.1.9: warp and splits computed as if z_n were this (0: off) */
     double tsm_focus;     /* TSM: focus point at this fraction of the body's view depth range (0: 0.5) */
@@ -84,6 +89,8 @@ typedef struct LightViewParams {
     int cascades;         /* z-partitions, 1 to LIGHTVIEW_MAX_CASCADES (0: 1) */
     SplitScheme split;
     double split_lambda;  /* practical scheme's weight of the log scheme, [0, 1] */
+    /* SPLIT_EXPLICIT: C_1..C_(m-1), view depths in world units inside (z_n, z_f), increasing; 0: not given */
+    double split_at[LIGHTVIEW_EXPLICIT_SPLITS];
     CascadeSelect select;
     double blend;         /* fraction of each slice, at its far end, dithered into the next one [0, 0.5] */
 } LightViewParams;
@@ -169,10 +176,17 @@ bool lightview_fit_with(const Scene *scene, const Light *light, MapProjection pr
                         Error *err);
 /* Whether a fit or projection depends on the camera (for resource keys). */
 bool lightview_follows_camera(MapProjection projection, MapFit fit, const LightViewParams *params);
-/* Split positions C_0..C_m over view depths [z_n, z_f] (course §3.2.3.1);
- * z_n is kept above 1e-9 z_f so the log scheme stays finite. */
-void lightview_splits(SplitScheme scheme, double lambda, int m, double z_n, double z_f, double pseudo_near,
-                      double *split);
+/* Split positions C_0..C_m over view depths [z_n, z_f] (course §3.2.3.1)
+ * by params' scheme (not SPLIT_FACES); z_n is kept above 1e-9 z_f so the log
+ * scheme stays finite. Explicit distances must have passed
+ * lightview_check_splits. */
+void lightview_splits(const LightViewParams *params, int m, double z_n, double z_f, double *split);
+/* Whether the explicit split distances fit m cascades over view depths
+ * (z_n, z_f): given for split_1..split_(m-1) only, inside the range and
+ * increasing; the error names the parameter and its valid range. `far_what`
+ * says where z_f comes from (for the message). */
+bool lightview_check_splits(const LightViewParams *params, int m, double z_n, double z_f, const char *far_what,
+                            Error *err);
 
 /* Where a world point falls in the map. */
 typedef struct MapCoord {

@@ -189,8 +189,10 @@ static LightViewParams relevant_params(const ShadowMapSpec *s)
     MapProjection p = s->projection;
     bool warp = p >= MAP_PROJ_PSM && p <= MAP_PROJ_LOGPSM, partitioned = v.cascades > 1 || v.split == SPLIT_FACES;
     if (!warp || p == MAP_PROJ_PSM) { v.warp_n = z.warp_n; v.falloff = z.falloff; }
+    if (p != MAP_PROJ_LISPSM && p != MAP_PROJ_LOGPSM) v.warp_n_world = z.warp_n_world;
     if (!warp && !partitioned) v.pseudo_near = z.pseudo_near;
     if (p != MAP_PROJ_TSM) v.tsm_focus = z.tsm_focus;
+    if (v.split != SPLIT_EXPLICIT) memcpy(v.split_at, z.split_at, sizeof v.split_at); /* given ones may be refused */
     if (!partitioned) { v.split = z.split; v.select = z.select; v.blend = z.blend; v.cascades = 1; }
     if (!partitioned || v.split != SPLIT_PRACTICAL) v.split_lambda = z.split_lambda;
     return v;
@@ -230,6 +232,8 @@ static uint64_t map_key(const Scene *sc, int light_index, const ShadowMapSpec *s
     for (size_t i = 0; i < sizeof ints / sizeof ints[0]; i++) hash_u64(&h, (uint64_t)ints[i]);
     const double reals[] = {v.warp_n, v.pseudo_near, v.tsm_focus, v.split_lambda, v.blend};
     for (size_t i = 0; i < sizeof reals / sizeof reals[0]; i++) hash_f64(&h, reals[i]);
+    hash_f64(&h, v.warp_n_world);
+    for (int i = 0; i < LIGHTVIEW_EXPLICIT_SPLITS; i++) hash_f64(&h, v.split_at[i]);
     return hash_final(&h);
 }
 

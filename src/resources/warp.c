@@ -87,6 +87,7 @@ typedef struct Frame {
     double y_min, y_max, x_min, x_max;
     double x_c;                 /* the eye's lateral position (the warp centre's) */
     double z0, z1;              /* view depths at the near and far ends of the body along a */
+    double world_per_ndc;       /* world units per base NDC unit at the body's near end */
     double gamma;
     bool axis_ok;
 } Frame;
@@ -150,6 +151,10 @@ static void frame_depths(const MapFace *f, const WarpSetup *w, Frame *fr)
         p0 = w->axis_from;
         p1 = w->axis_to;
     }
+    /* The base is square: an ortho NDC unit is base_half world units anywhere, a perspective one
+     * base_half tangents, i.e. base_half x the light depth world units there (at least the near plane's). */
+    double light_depth = -m4_apply(&f->view_from_world, p0).z;
+    fr->world_per_ndc = f->base_half * (f->base_perspective ? fmax(light_depth, f->raster.depth_near) : 1.0);
     fr->z0 = fmin(fmax(view_depth(w->view, p0), w->z_min), w->z_max);
     fr->z1 = fmin(fmax(view_depth(w->view, p1), w->z_min), w->z_max);
     if (!isfinite(fr->z0)) fr->z0 = w->z_min;
@@ -202,19 +207,24 @@ static double tsm_n(const MapFace *f, const WarpSetup *w, const Frame *fr)
     return den > 1e-12 * D ? D * delta * (1.0 - TSM_XI) / den : INFINITY; /* focus past 80%: uniform does it */
 }
 
-/* n (base NDC units, INFINITY = uniform) for the perspective warps. */
+/* n (base NDC units, INFINITY = uniform) for the perspective warps: the
+ * falloff's n times warp_n, TSM's from its focus, or a free n in world
+ * units (course Fig. 3.6: "the parameter n is free"), used as given. */
 static double warp_n(const MapFace *f, const WarpSetup *w, const Frame *fr, double theta)
 {
     double D = fr->y_max - fr->y_min, alpha = fr->z1 / fr->z0;
     if (!fr->axis_ok || !(D > 0.0) || w->kind == MAP_PROJ_ORTHO) return INFINITY;
     double k = falloff_factor(w->params->falloff, fr->gamma, theta, alpha);
-    double mult = w->params->warp_n > 0.0 ? w->params->warp_n : 1.0;
+    double mult = w->params->warp_n > 0.0 ? w->params->warp_n : 1.0, n_world = w->params->warp_n_world;
     double n;
-    switch (w->kind) {
-    case MAP_PROJ_TSM: n = tsm_n(f, w, fr) * k; break;
-    case MAP_PROJ_LOGPSM: n = D * warp_n_over_d(1.0, alpha) * k * mult; break; /* PSM-like: constant lateral error */
-    default: n = D * warp_n_over_d(0.0, alpha) * k * mult; break;              /* LiSPSM: n_opt, Wimmer 2004 */
-    }
+    if (n_world > 0.0 && (w->kind == MAP_PROJ_LISPSM || w->kind == MAP_PROJ_LOGPSM))
+        n = n_world / fr->world_per_ndc;
+    else if (w->kind == MAP_PROJ_TSM)
+        n = tsm_n(f, w, fr) * k;
+    else if (w->kind == MAP_PROJ_LOGPSM)
+        n = D * warp_n_over_d(1.0, alpha) * k * mult; /* PSM-like: constant lateral error */
+    else
+        n = D * warp_n_over_d(0.0, alpha) * k * mult; /* LiSPSM: n_opt, Wimmer 2004 */
     return n > N_UNIFORM * D || !isfinite(n) ? INFINITY : fmax(n, 1e-9 * D);
 }
 

@@ -28,7 +28,7 @@ enum { P_THRESHOLD = SMAP_NUM_PARAMS, P_MAX_LEVEL, P_COLOR_THRESHOLD, P_FIXED, P
 
 /* Plain perspective maps along the light's normal (light_axes): no warps or face splits. */
 static const ParamDesc aa_params[] = {
-    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_PERSPECTIVE, LIGHTVIEW_MAX_CASCADES, SPLIT_UNIFORM),
+    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_PERSPECTIVE, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT),
     SMAP_BIAS_PARAMS_PLANE(1),
     {"threshold", PARAM_FLOAT, 0.2244, 0, 0.25, "",
      "visibility variance E - E^2 above which a region splits into 4 (seed 001 §3: 0.2244; Fig. 2: 0.10, 0.22, 0.24)",

@@ -11,6 +11,8 @@ const char *const smap_falloff_names[] = {WARP_FALLOFF_NAMES, NULL};
 const char *const smap_split_names[] = {SPLIT_SCHEME_NAMES, NULL};
 const char *const smap_select_names[] = {CASCADE_SELECT_NAMES, NULL};
 
+_Static_assert(SMAP_P_SPLIT_3 - SMAP_P_SPLIT_1 + 1 == LIGHTVIEW_EXPLICIT_SPLITS, "one split_k per explicit distance");
+
 ShadowMapSpec smap_spec(const double *p)
 {
     static const int bits[] = {0, 24, 16};
@@ -20,10 +22,12 @@ ShadowMapSpec smap_spec(const double *p)
     s.fit = (MapFit)(int)p[SMAP_P_FIT];
     s.depth = (int)p[SMAP_P_DEPTH] == 1 ? RASTER_DEPTH_NDC : RASTER_DEPTH_LINEAR;
     s.depth_bits = bits[(int)p[SMAP_P_DEPTH_BITS]];
-    s.view = (LightViewParams){.warp_n = p[SMAP_P_WARP_N], .falloff = (WarpFalloff)(int)p[SMAP_P_WARP_FALLOFF],
+    s.view = (LightViewParams){.warp_n = p[SMAP_P_WARP_N], .warp_n_world = p[SMAP_P_WARP_N_WORLD],
+                               .falloff = (WarpFalloff)(int)p[SMAP_P_WARP_FALLOFF],
                                .pseudo_near = p[SMAP_P_PSEUDO_NEAR], .tsm_focus = p[SMAP_P_TSM_FOCUS],
                                .stabilize = p[SMAP_P_STABILIZE] != 0.0, .cascades = (int)p[SMAP_P_CASCADES],
                                .split = (SplitScheme)(int)p[SMAP_P_SPLIT_SCHEME], .split_lambda = p[SMAP_P_SPLIT_LAMBDA],
+                               .split_at = {p[SMAP_P_SPLIT_1], p[SMAP_P_SPLIT_2], p[SMAP_P_SPLIT_3]},
                                .select = (CascadeSelect)(int)p[SMAP_P_CASCADE_SELECT],
                                .blend = p[SMAP_P_CASCADE_BLEND]};
     return s;

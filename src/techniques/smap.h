@@ -20,6 +20,14 @@ extern const char *const smap_falloff_names[];
 extern const char *const smap_split_names[];
 extern const char *const smap_select_names[];
 
+/* An explicit split distance C_k (LIGHTVIEW_EXPLICIT_SPLITS of them). */
+#define SMAP_SPLIT_PARAM(name, k, next)                                                                             \
+    {name, PARAM_FLOAT, 0, 0, 1e9, "world units",                                                                   \
+     "split_scheme=explicit: the view depth where cascade " k " ends and cascade " next " begins, inside the "    \
+     "view's (z_n, z_f) and beyond the split before it; cascades=m takes split_1..split_(m-1), each given, the "   \
+     "others 0 (0: not given); pseudo_near does not move it",                                                      \
+     NULL}
+
 #define SMAP_MAP_PARAMS SMAP_MAP_PARAMS_UPTO(MAP_PROJ_COUNT - 1, LIGHTVIEW_MAX_CASCADES, SPLIT_FACES)
 /* The same for a technique that accepts only the projections up to
  * `proj_max`, at most `cascades_max` maps and the split schemes up to
@@ -48,7 +56,13 @@ extern const char *const smap_select_names[];
      smap_bits_names},                                                                                             \
     {"warp_n", PARAM_FLOAT, 1, 0.01, 1e6, "x n_opt",                                                                  \
      "lispsm and logpsm: the warp's n as a multiple of the falloff's n (lispsm: n_opt = z_n + sqrt(z_f z_n) for "  \
-     "a view perpendicular to the light, course §3.2.2.3); small n warps toward PSM, large toward uniform",         \
+     "a view perpendicular to the light, course §3.2.2.3; with warp_falloff=none exactly warp_n x n_opt); small n " \
+     "warps toward PSM, large toward uniform",                                                                     \
+     NULL},                                                                                                        \
+    {"warp_n_world", PARAM_FLOAT, 0, 0, 1e9, "world units",                                                          \
+     "lispsm and logpsm: a free n (course Fig. 3.6), the warp centre's distance before the body's near end along " \
+     "the view's image, used as given (warp_n and warp_falloff then do nothing); measured in the light's plane, "   \
+     "for lights with a position at the light depth of the body's near end; 0: off",                             \
      NULL},                                                                                                        \
     {"warp_falloff", PARAM_ENUM, 0, 0, 2, "",                                                                        \
      "how the warp relaxes as the view turns toward the light's direction (angle gamma): Lloyd's (thesis "         \
@@ -63,8 +77,10 @@ extern const char *const smap_select_names[];
      "line of the map (Martin & Tan 2004)",                                                                        \
      NULL},                                                                                                        \
     {"stabilize", PARAM_BOOL, 0, 0, 1, "",                                                                           \
-     "uniform maps of directional lights: world-fixed orientation and texel-snapped extents on a ladder of "       \
-     "sizes, so texels stay still as the camera moves (course §3.2.1); no effect on other maps",                   \
+     "unwarped single-face maps (ortho, perspective; also per cascade): world-fixed orientation (a spot, rect or "  \
+     "disk light's own axis, a point or sphere light aimed at the scene's centre) and texel-snapped extents on a "  \
+     "ladder of sizes, so texels stay still as the camera moves (course §3.2.1); cube and paraboloid maps are "     \
+     "world-fixed already; no effect on warped maps (psm, lispsm, tsm, logpsm, warped frustum faces)",           \
      NULL},                                                                                                        \
     {"cascades", PARAM_INT, 1, 1, cascades_max, "maps",                                                             \
      "z-partitioning (cascaded / parallel-split shadow maps, course §3.2.3.1): this many maps of map_size^2, "      \
@@ -72,10 +88,13 @@ extern const char *const smap_select_names[];
      NULL},                                                                                                        \
     {"split_scheme", PARAM_ENUM, 0, 0, split_max, "",                                                               \
      "split positions: practical (lambda log + (1 - lambda) uniform, Zhang 2006), log (C_i = z_n (z_f/z_n)^(i/m), " \
-     "Lloyd 2006), uniform, or faces (one warped map per light-facing face of the view frustum, course §3.2.3.2)", \
+     "Lloyd 2006), uniform, explicit (the view depths split_1..split_3: up to 4 cascades), or faces (one warped "   \
+     "map per light-facing face of the view frustum, course §3.2.3.2)",                                            \
      smap_split_names},                                                                                            \
     {"split_lambda", PARAM_FLOAT, 0.5, 0, 1, "",                                                                     \
      "practical split scheme: weight of the logarithmic positions (0: uniform, 1: log)", NULL},                    \
+    SMAP_SPLIT_PARAM("split_1", "1", "2"), SMAP_SPLIT_PARAM("split_2", "2", "3"),                                  \
+    SMAP_SPLIT_PARAM("split_3", "3", "4"),                                                                         \
     {"cascade_select", PARAM_ENUM, 0, 0, 1, "",                                                                      \
      "which cascade a point uses: the slice of its view depth, or the nearest cascade whose map contains it "      \
      "(better with the light near the view axis, Zhang 2009)",                                                     \
@@ -110,8 +129,9 @@ extern const char *const smap_select_names[];
 
 enum {
     SMAP_P_MAP_SIZE, SMAP_P_PROJECTION, SMAP_P_FIT, SMAP_P_DEPTH, SMAP_P_DEPTH_BITS,
-    SMAP_P_WARP_N, SMAP_P_WARP_FALLOFF, SMAP_P_PSEUDO_NEAR, SMAP_P_TSM_FOCUS, SMAP_P_STABILIZE,
-    SMAP_P_CASCADES, SMAP_P_SPLIT_SCHEME, SMAP_P_SPLIT_LAMBDA, SMAP_P_CASCADE_SELECT, SMAP_P_CASCADE_BLEND,
+    SMAP_P_WARP_N, SMAP_P_WARP_N_WORLD, SMAP_P_WARP_FALLOFF, SMAP_P_PSEUDO_NEAR, SMAP_P_TSM_FOCUS, SMAP_P_STABILIZE,
+    SMAP_P_CASCADES, SMAP_P_SPLIT_SCHEME, SMAP_P_SPLIT_LAMBDA, SMAP_P_SPLIT_1, SMAP_P_SPLIT_2, SMAP_P_SPLIT_3,
+    SMAP_P_CASCADE_SELECT, SMAP_P_CASCADE_BLEND,
     SMAP_P_BIAS, SMAP_P_BIAS_STEPS, SMAP_P_SLOPE_BIAS, SMAP_P_SLOPE_MAX, SMAP_P_NORMAL_OFFSET, SMAP_P_RECEIVER_PLANE,
     SMAP_NUM_PARAMS
 };

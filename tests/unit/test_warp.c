@@ -28,17 +28,23 @@ static Lab *open_plane(void)
     return lab;
 }
 
-/* The map the shared parameters ask for ("name=value" assignments). */
-static const ShadowMap *map_with(Lab *lab, const char *const *assign, int n)
+/* The map the shared parameters ask for ("name=value" assignments), or
+ * NULL and why. */
+static const ShadowMap *map_or_error(Lab *lab, const char *const *assign, int n, Error *err)
 {
-    Error err;
-    const Technique *t = tech_find("aliasing", &err);
+    const Technique *t = tech_find("aliasing", err);
     double p[TECH_MAX_PARAMS];
     tech_params_default(t, p);
     for (int i = 0; i < n; i++)
-        if (!tech_param_parse(t, assign[i], p, &err)) { printf("    %s\n", err.msg); return NULL; }
+        if (!tech_param_parse(t, assign[i], p, err)) return NULL;
     ShadowMapSpec spec = smap_spec(p);
-    const ShadowMap *m = res_shadow_map(lab_resources(lab), lab_scene(lab), 0, &spec, &err);
+    return res_shadow_map(lab_resources(lab), lab_scene(lab), 0, &spec, err);
+}
+
+static const ShadowMap *map_with(Lab *lab, const char *const *assign, int n)
+{
+    Error err;
+    const ShadowMap *m = map_or_error(lab, assign, n, &err);
     if (!m) printf("    %s\n", err.msg);
     return m;
 }
@@ -61,20 +67,22 @@ static bool axis_error(const Scene *sc, const ShadowMap *m, double z, AxisError 
 /* n view depths from z_n to z_f inclusive, log spaced (a hair inside the ends) */
 static double z_at(int i, int n) { return Z_N * pow(Z_F / Z_N, (double)i / (n - 1)) * (1.0 + 1e-9 * (i == 0) - 1e-9 * (i == n - 1)); }
 
-typedef double (*ClosedForm)(double z);
+/* The closed forms at view depth z; n is LiSPSM's (world units), unused by the others. */
+typedef double (*ClosedForm)(double z, double n);
 static const double D = Z_F - Z_N;
 static double n_opt(void) { return Z_N + sqrt(Z_F * Z_N); }
-static double uni_y(double z) { return D / z; }
-static double uni_x(double z) { return Z_F / z; }
-static double psm_y(double z) { return z * D / (Z_N * Z_F); }
-static double psm_x(double z) { (void)z; return 1.0; }
-static double lis_y(double z) { double n = n_opt(), w = z - Z_N + n; return w * w * D / (z * n * (n + D)); }
-static double lis_x(double z) { double n = n_opt(); return Z_F * (z - Z_N + n) / ((D + n) * z); }
-static double log_y(double z) { (void)z; return log(Z_F / Z_N); }
+static double uni_y(double z, double n) { (void)n; return D / z; }
+static double uni_x(double z, double n) { (void)n; return Z_F / z; }
+static double psm_y(double z, double n) { (void)n; return z * D / (Z_N * Z_F); }
+static double psm_x(double z, double n) { (void)z; (void)n; return 1.0; }
+static double lis_y(double z, double n) { double w = z - Z_N + n; return w * w * D / (z * n * (n + D)); }
+static double lis_x(double z, double n) { return Z_F * (z - Z_N + n) / ((D + n) * z); }
+static double log_y(double z, double n) { (void)z; (void)n; return log(Z_F / Z_N); }
 
-/* Max relative deviation of the measured errors from the closed forms over
- * z_n..z_f; the maxima of both axes go to *max_x, *max_y. */
-static double deviation(Lab *lab, const ShadowMap *m, ClosedForm fx, ClosedForm fy, double *max_x, double *max_y)
+/* Max relative deviation of the measured errors from the closed forms (at
+ * LiSPSM's n) over z_n..z_f; the maxima of both axes go to *max_x, *max_y. */
+static double deviation(Lab *lab, const ShadowMap *m, ClosedForm fx, ClosedForm fy, double n, double *max_x,
+                        double *max_y)
 {
     double worst = 0.0;
     *max_x = *max_y = 0.0;
@@ -84,7 +92,7 @@ static double deviation(Lab *lab, const ShadowMap *m, ClosedForm fx, ClosedForm 
         if (!axis_error(lab_scene(lab), m, z, &e)) return INFINITY;
         e.e_x /= MARGIN;
         e.e_y /= MARGIN;
-        worst = fmax(worst, fmax(fabs(e.e_x / fx(z) - 1.0), fabs(e.e_y / fy(z) - 1.0)));
+        worst = fmax(worst, fmax(fabs(e.e_x / fx(z, n) - 1.0), fabs(e.e_y / fy(z, n) - 1.0)));
         *max_x = fmax(*max_x, e.e_x);
         *max_y = fmax(*max_y, e.e_y);
     }
@@ -102,7 +110,7 @@ TEST(test_warp_measured_error_matches_the_closed_forms)
         const char *a[] = {"fit=body", "map_size=1024", projs[k]};
         const ShadowMap *m = map_with(lab, a, 3);
         CHECK(m);
-        double mx, my, dev = deviation(lab, m, fx[k], fy[k], &mx, &my);
+        double mx, my, dev = deviation(lab, m, fx[k], fy[k], n_opt(), &mx, &my);
         prod[k] = mx * my;
         printf("    %-17s max e_x %8.3f  max e_y %8.3f  product %8.1f  worst deviation %.2f%%\n", projs[k], mx, my,
                prod[k], 100 * dev);
@@ -112,13 +120,118 @@ TEST(test_warp_measured_error_matches_the_closed_forms)
     const char *a2[] = {"fit=body", "map_size=1024", "projection=lispsm", "warp_n=2"};
     const ShadowMap *m2 = map_with(lab, a2, 4);
     CHECK(m2);
-    double mx2, my2, dev2 = deviation(lab, m2, lis_x, lis_y, &mx2, &my2);
+    double mx2, my2, dev2 = deviation(lab, m2, lis_x, lis_y, n_opt(), &mx2, &my2);
     printf("    lispsm warp_n=2 against the n_opt closed forms: worst deviation %.1f%%\n", 100 * dev2);
     CHECK(dev2 > 0.2);
     /* Lloyd et al. 2006: all perspective warps share the error product (99 for z_f / z_n = 100) */
     CHECK_NEAR(prod[1], 99.0, 99.0 * 0.05);
     CHECK_NEAR(prod[2], 99.0, 99.0 * 0.05);
     CHECK_NEAR(prod[0], 9900.0, 9900.0 * 0.05);
+    lab_close(lab);
+}
+
+/* Course Fig. 3.6: "the parameter n is free and can vary between z_n (PSM)
+ * and infinity (uniform)". Each way of giving it reaches the n it names:
+ * warp_n x n_opt (no falloff), and a free n in world units (warp_n_world),
+ * whose measured errors follow the closed forms at that n (n = z_n: PSM's);
+ * the free n is used as given, whatever the falloff. */
+TEST(test_warp_lispsm_n_free_or_a_multiple_of_n_opt)
+{
+    Lab *lab = open_plane();
+    CHECK(lab);
+    static const struct { const char *assign; double times_n_opt, world; } cases[] = {
+        {"warp_n=2", 2, 0}, {"warp_n=0.3", 0.3, 0}, {"warp_n_world=1", 0, 1}, {"warp_n_world=3", 0, 3},
+        {"warp_n_world=11", 0, 11}, {"warp_n_world=40", 0, 40}, {"warp_n_world=1000", 0, 1000},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        const char *a[] = {"fit=body", "map_size=1024", "projection=lispsm", "warp_falloff=none", cases[k].assign};
+        const ShadowMap *m = map_with(lab, a, 5);
+        CHECK(m);
+        double n = cases[k].world > 0 ? cases[k].world : cases[k].times_n_opt * n_opt();
+        double mx, my, dev = deviation(lab, m, lis_x, lis_y, n, &mx, &my);
+        printf("    %-18s n = %7.4g: max e_x %8.3f  max e_y %8.3f  product %6.2f  worst deviation %.3f%%\n",
+               cases[k].assign, n, mx, my, mx * my, 100 * dev);
+        CHECK_MSG(dev < 0.01, "%s deviates %.2f%% from the closed forms at n = %g", cases[k].assign, 100 * dev, n);
+        if (n == Z_N) { /* n = z_n is PSM's depth-axis error */
+            double px, py;
+            CHECK(deviation(lab, m, lis_x, psm_y, Z_N, &px, &py) < 0.01);
+        }
+    }
+    lab_close(lab);
+    /* light 40 degrees off the view: the falloffs give different n, a free n stays as given */
+    Error err;
+    const char *ov[] = {"lights[1].direction={0,-0.6428,-0.7660}"};
+    lab = lab_open("scenes/overhead-plane.lua", ov, 1, &err);
+    CHECK(lab);
+    double n_of[2][3];
+    static const char *const falloffs[] = {"warp_falloff=lloyd", "warp_falloff=sin_gamma", "warp_falloff=none"};
+    for (int f = 0; f < 3; f++) {
+        const char *a[] = {"fit=body", "map_size=256", "projection=lispsm", falloffs[f]};
+        const char *b[] = {"fit=body", "map_size=256", "projection=lispsm", falloffs[f], "warp_n_world=20"};
+        const ShadowMap *ma = map_with(lab, a, 4), *mb = map_with(lab, b, 5);
+        CHECK(ma && mb);
+        n_of[0][f] = ma->view.face[0].warp_n;
+        n_of[1][f] = mb->view.face[0].warp_n;
+    }
+    printf("    gamma 40 deg, n in base NDC: falloffs %.5g %.5g %.5g; warp_n_world=20: %.5g %.5g %.5g\n", n_of[0][0],
+           n_of[0][1], n_of[0][2], n_of[1][0], n_of[1][1], n_of[1][2]);
+    CHECK(fabs(n_of[0][0] - n_of[0][2]) > 0.01 * n_of[0][2] && fabs(n_of[0][1] - n_of[0][2]) > 0.01 * n_of[0][2]);
+    CHECK(n_of[1][0] == n_of[1][2] && n_of[1][1] == n_of[1][2] && isfinite(n_of[1][0]));
+    lab_close(lab);
+}
+
+/* Explicit split distances (split_scheme=explicit): the map's slices are the
+ * given view depths, each slice's uniform map has the uniform closed form's
+ * depth-axis error (b - a) / a at its near end; the given distances are part
+ * of the map's key; too few, too many, unordered or out-of-range distances
+ * are refused naming the parameter and the valid range. */
+TEST(test_warp_explicit_splits_are_the_given_distances)
+{
+    Lab *lab = open_plane();
+    CHECK(lab);
+    const double given[5] = {Z_N, 3, 12, 40, Z_F};
+    const char *a[] = {"fit=body", "map_size=1024", "projection=ortho", "split_scheme=explicit", "cascades=4",
+                       "split_1=3", "split_2=12", "split_3=40"};
+    const ShadowMap *m = map_with(lab, a, 8);
+    CHECK(m && m->num_faces == 4 && m->view.num_cascades == 4);
+    for (int i = 0; i <= 4; i++)
+        CHECK_MSG(m->view.split[i] == given[i], "split %d: %g, not %g", i, m->view.split[i], given[i]);
+    for (int i = 0; i < 4; i++) {
+        double lo = given[i], hi = given[i + 1], max_y = 0.0;
+        for (int k = 0; k < 40; k++) {
+            double z = lo * pow(hi / lo, k / 39.0) * (1.0 + 1e-9 * (k == 0) - 1e-9 * (k == 39));
+            AxisError e;
+            CHECK(axis_error(lab_scene(lab), m, z, &e));
+            CHECK_MSG(e.face == i, "depth %g uses map %d, not %d", z, e.face, i);
+            max_y = fmax(max_y, e.e_y / MARGIN);
+        }
+        double bound = (hi - lo) / lo;
+        printf("    slice [%g, %g]: max e_y %.4f, uniform closed form (b - a) / a = %.4f\n", lo, hi, max_y, bound);
+        CHECK_NEAR(max_y, bound, 0.01 * bound);
+    }
+    const char *b[] = {"fit=body", "map_size=1024", "projection=ortho", "split_scheme=explicit", "cascades=4",
+                       "split_1=5", "split_2=12", "split_3=40"};
+    const ShadowMap *m5 = map_with(lab, b, 8);
+    CHECK(m5 && m5 != m && m5->view.split[1] == 5.0);
+    static const struct { const char *assign[4]; const char *want[2]; } refused[] = {
+        {{"cascades=4", "split_1=3", "split_2=12", "split_3=0"}, {"split_3 is not given", "split_1..split_3"}},
+        {{"cascades=5", "split_1=3", "split_2=12", "split_3=40"}, {"cascades 5", "[1, 4]"}},
+        {{"cascades=4", "split_1=12", "split_2=3", "split_3=40"}, {"split_2 = 3", "(12, 100)"}},
+        {{"cascades=4", "split_1=3", "split_2=12", "split_3=150"}, {"split_3 = 150", "(12, 100)"}},
+        {{"cascades=4", "split_1=0.5", "split_2=12", "split_3=40"}, {"split_1 = 0.5", "(1, 100)"}},
+        {{"cascades=2", "split_1=3", "split_2=12", "split_3=0"}, {"split_2 = 12 is given", "cascades 2"}},
+        {{"cascades=1", "split_1=3", "split_2=0", "split_3=0"}, {"split_1 = 3 is given", "cascades 1"}},
+    };
+    for (size_t k = 0; k < sizeof refused / sizeof refused[0]; k++) {
+        const char *c[] = {"fit=body", "map_size=64", "projection=ortho", "split_scheme=explicit", refused[k].assign[0],
+                           refused[k].assign[1], refused[k].assign[2], refused[k].assign[3]};
+        Error err = {{0}};
+        const ShadowMap *bad = map_or_error(lab, c, 8, &err);
+        printf("    %s %s %s %s: %s\n", c[4], c[5], c[6], c[7], bad ? "accepted" : err.msg);
+        CHECK(!bad);
+        for (int w = 0; w < 2; w++)
+            CHECK_MSG(strstr(err.msg, refused[k].want[w]), "the refusal lacks '%s': %s", refused[k].want[w], err.msg);
+    }
     lab_close(lab);
 }
 
@@ -159,7 +272,7 @@ TEST(test_warp_logpsm_has_constant_error_ln_r)
     const char *a[] = {"fit=body", "map_size=1024", "projection=logpsm"};
     const ShadowMap *m = map_with(lab, a, 3);
     CHECK(m);
-    double mx, my, dev = deviation(lab, m, psm_x, log_y, &mx, &my);
+    double mx, my, dev = deviation(lab, m, psm_x, log_y, 0.0, &mx, &my);
     printf("    logpsm: max e_y %.3f (ln r = %.3f), max e_x %.3f, worst deviation %.2f%%\n", my, log(Z_F / Z_N), mx,
            100 * dev);
     CHECK(dev < 0.05);
@@ -208,34 +321,69 @@ TEST(test_warp_lloyd_falloff_and_n_are_continuous)
     CHECK(isinf(warp_n_over_d(0.0, 1.0))); /* no depth range: nothing to warp */
 }
 
-TEST(test_warp_stabilized_texels_stay_put_when_the_camera_moves)
+/* Texel size and the texel phase of a world point in map face 0, with the
+ * camera at two places (fit=body: an unstabilized map follows the view). */
+typedef struct Phase { double texel[2], phase[2][2]; } Phase;
+
+/* How far the grid moved, in texels (phases are modulo 1: 0.9999 and 0 are close). */
+static double phase_shift(const Phase *p)
+{
+    double d = 0.0;
+    for (int a = 0; a < 2; a++) {
+        double x = fabs(p->phase[0][a] - p->phase[1][a]);
+        d += fmin(x, 1.0 - x);
+    }
+    return d;
+}
+
+static bool phases(const char *light, const char *projection, bool stabilize, Phase *ph)
 {
     const char *moves[] = {"camera.position={0,0,0}", "camera.position={0.37,0.05,-0.61}"};
-    double origin[2][2], texel[2], origin_free[2][2];
     for (int k = 0; k < 2; k++) {
         Error err;
-        const char *ov[] = {moves[k], "camera.target={0.2,0,-1}"};
-        Lab *lab = lab_open("scenes/overhead-plane.lua", ov, 2, &err);
-        CHECK(lab);
-        const char *st[] = {"fit=body", "map_size=1024", "stabilize=true"}, *fr[] = {"fit=body", "map_size=1024"};
-        const ShadowMap *a = map_with(lab, st, 3), *b = map_with(lab, fr, 2);
-        CHECK(a && b);
-        texel[k] = (a->view.face[0].r - a->view.face[0].l) / a->res;
-        /* where world point (0, 0, 0) falls, in texels: its fraction is the grid's phase */
-        MapCoord ma = lightview_locate_on(&a->view, 0, d3(0, -0.5, -30)), mb = lightview_locate_on(&b->view, 0, d3(0, -0.5, -30));
-        origin[k][0] = ma.s - floor(ma.s);
-        origin[k][1] = ma.t - floor(ma.t);
-        origin_free[k][0] = mb.s - floor(mb.s);
-        origin_free[k][1] = mb.t - floor(mb.t);
+        const char *ov[] = {"camera.width=64", "camera.height=48", moves[k], "camera.target={0.2,0,-1}", light};
+        Lab *lab = lab_open("scenes/overhead-plane.lua", ov, light ? 5 : 4, &err);
+        if (!lab) { printf("    %s\n", err.msg); return false; }
+        const char *a[] = {"fit=body", "map_size=1024", projection, stabilize ? "stabilize=true" : "stabilize=false"};
+        const ShadowMap *m = map_with(lab, a, 4);
+        if (m) {
+            ph->texel[k] = (m->view.face[0].r - m->view.face[0].l) / m->res;
+            MapCoord mc = lightview_locate_on(&m->view, 0, d3(0, -0.5, -30));
+            ph->phase[k][0] = mc.s - floor(mc.s);
+            ph->phase[k][1] = mc.t - floor(mc.t);
+        }
         lab_close(lab);
+        if (!m) return false;
     }
-    printf("    stabilized: texel %.6f -> %.6f, phase (%.4f, %.4f) -> (%.4f, %.4f); free: (%.4f, %.4f) -> (%.4f, %.4f)\n",
-           texel[0], texel[1], origin[0][0], origin[0][1], origin[1][0], origin[1][1], origin_free[0][0],
-           origin_free[0][1], origin_free[1][0], origin_free[1][1]);
-    CHECK_NEAR(texel[0], texel[1], 1e-12 * texel[0]);
-    CHECK_NEAR(origin[0][0], origin[1][0], 1e-6);
-    CHECK_NEAR(origin[0][1], origin[1][1], 1e-6);
-    CHECK(fabs(origin_free[0][0] - origin_free[1][0]) + fabs(origin_free[0][1] - origin_free[1][1]) > 1e-3);
+    return true;
+}
+
+/* Course §3.2.1: orientation-fixed, texel-snapped fitting keeps the texel
+ * grid still in world space as the camera moves: uniform maps of a
+ * directional light, and the perspective maps of a spot and a point light
+ * (their window snapped in tangents at unit depth); without it the grid
+ * moves. */
+TEST(test_warp_stabilized_texels_stay_put_when_the_camera_moves)
+{
+    static const struct { const char *what, *light, *projection; } lights[] = {
+        {"directional", NULL, "projection=ortho"},
+        {"spot", "lights[1]={type='spot',position={0,30,-50},direction={0,-1,0},cone_angle=80}",
+         "projection=perspective"},
+        {"point", "lights[1]={type='point',position={0,30,-50}}", "projection=perspective"},
+    };
+    for (size_t k = 0; k < sizeof lights / sizeof lights[0]; k++) {
+        Phase st, fr;
+        CHECK(phases(lights[k].light, lights[k].projection, true, &st));
+        CHECK(phases(lights[k].light, lights[k].projection, false, &fr));
+        printf("    %-11s stabilized: texel %.6g -> %.6g, phase (%.4f, %.4f) -> (%.4f, %.4f); free: (%.4f, %.4f) -> "
+               "(%.4f, %.4f)\n", lights[k].what, st.texel[0], st.texel[1], st.phase[0][0], st.phase[0][1],
+               st.phase[1][0], st.phase[1][1], fr.phase[0][0], fr.phase[0][1], fr.phase[1][0], fr.phase[1][1]);
+        CHECK_NEAR(st.texel[0], st.texel[1], 1e-12 * st.texel[0]);
+        CHECK_MSG(phase_shift(&st) < 1e-6, "%s: the stabilized grid moved by %g texels", lights[k].what,
+                  phase_shift(&st));
+        CHECK_MSG(phase_shift(&fr) > 1e-3, "%s: the free map's grid did not move, the test would be vacuous",
+                  lights[k].what);
+    }
 }
 
 /* Course §3.2.3.2: under an overhead light only the top face of the view

@@ -5,7 +5,9 @@
  * overhead sun and equals it when the light is behind the viewer (§3.2.2,
  * §3.2.3: "warping degenerates to uniform shadow mapping"); the degenerate
  * configurations of the issue give finite maps, visibilities in [0, 1] and
- * finite error figures; the analysis is built only when asked for. */
+ * finite error figures for directional, spot and point lights, and PSM
+ * with a light behind the eye classifies like the unwarped map (on
+ * scenes/overhead-plane.lua); the analysis is built only when asked for. */
 #include <stdlib.h>
 #include <string.h>
 #include "fixtures.h"
@@ -107,17 +109,21 @@ TEST(test_lispsm_beats_uniform_overhead_and_equals_it_with_the_light_behind)
     lab_close(lab);
 }
 
-/* Every warp and cascades on a scene: the map builds, the aliasing render
- * is finite and in [0, 1], its readings and summary are finite. */
+/* Every warp (LiSPSM also with a free n), cascades and frustum faces on a
+ * scene: the map builds, the aliasing render is finite and in [0, 1], its
+ * readings and summary are finite. Lights with a position take
+ * perspective slices where a directional light takes ortho ones. */
 static void check_finite(const char *what, Lab *lab)
 {
-    static const char *const projs[] = {"projection=psm", "projection=lispsm", "projection=tsm", "projection=logpsm",
-                                        "projection=ortho", "projection=lispsm"};
+    bool directional = lab_scene(lab)->lights[0].kind == LIGHT_DIRECTIONAL;
+    const char *flat = directional ? "projection=ortho" : "projection=perspective";
+    const char *const projs[] = {"projection=psm", "projection=lispsm", "projection=tsm", "projection=logpsm",
+                                 flat, "projection=lispsm", "projection=lispsm"};
     static const char *const parts[] = {"cascades=1", "cascades=1", "cascades=1", "cascades=1", "cascades=4",
-                                        "split_scheme=faces"};
+                                        "split_scheme=faces", "warp_n_world=2"};
     Error err;
     const Technique *t = tech_find("aliasing", &err);
-    for (int k = 0; k < 6; k++) {
+    for (int k = 0; k < 7; k++) {
         const char *a[] = {"fit=body", "map_size=256", projs[k], parts[k], k == 5 ? "cascades=1" : "split_scheme=log"};
         double p[TECH_MAX_PARAMS];
         CHECK(params_of(t, a, 5, p));
@@ -136,31 +142,73 @@ static void check_finite(const char *what, Lab *lab)
         const AliasingSummary *s = &an->sum;
         for (size_t i = 0; i < (size_t)m->num_faces * m->res * m->res; i++) bad += isnan(m->depth[i]);
         bad += !isfinite(s->m_max) + !isfinite(s->m_mean) + !isfinite(s->storage);
-        printf("    %-24s %-17s %-18s %5ld measured, m max %-9.4g storage %-9.4g non-finite %ld\n", what, projs[k],
-               parts[k], s->measured, s->m_max, s->storage, bad);
+        printf("    %-11s %-30s %-17s %-18s %5ld measured, m max %-9.4g storage %-9.4g non-finite %ld%s\n",
+               light_kind_name(lab_scene(lab)->lights[0].kind), what, projs[k], parts[k], s->measured, s->m_max,
+               s->storage, bad, m->view.face[0].warp_fallback ? " (fell back)" : "");
         CHECK_MSG(bad == 0, "%s, %s: %ld non-finite or out-of-range values", what, projs[k], bad);
     }
 }
 
-TEST(test_warp_degenerate_configurations_stay_finite)
+static void check_cases(const char *kind, const char *const (*cases)[5], int n_cases)
 {
-    static const struct { const char *what, *ov[3]; } cases[] = {
-        {"light along the view", {"lights[1].direction={0,0,-1}", NULL, NULL}},          /* gamma = 0, light behind */
-        {"light against the view", {"lights[1].direction={0,-0.01,1}", NULL, NULL}},     /* toward the eye */
-        {"near 1e-6, far 1", {"camera.near=0.000001", "camera.far=1", NULL}},
-        {"far / near = 1e6", {"camera.near=0.0001", "camera.far=100", NULL}},
-        {"empty body", {"camera.position={0,50,0}", "camera.target={0,60,0}", "camera.up={1,0,0}"}}, /* the sky */
-        {"light grazing the ground", {"lights[1].direction={0,-0.0001,-1}", NULL, NULL}},
-    };
-    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
-        const char *ov[5] = {"camera.width=64", "camera.height=48"};
+    for (int c = 0; c < n_cases; c++) {
+        const char *ov[6] = {"camera.width=64", "camera.height=48"};
         int n = 2;
-        for (int k = 0; k < 3 && cases[c].ov[k]; k++) ov[n++] = cases[c].ov[k];
+        for (int k = 1; k < 5 && cases[c][k]; k++) ov[n++] = cases[c][k];
         Lab *lab = open_with("scenes/overhead-plane.lua", ov, n);
-        CHECK(lab);
-        check_finite(cases[c].what, lab);
+        CHECK_MSG(lab, "%s light, %s", kind, cases[c][0]);
+        check_finite(cases[c][0], lab);
         lab_close(lab);
     }
+}
+
+/* A spot or point light at `pos` (spots aimed along `dir`), as an override. */
+#define SPOT(pos, dir) "lights[1]={type='spot',position=" pos ",direction=" dir ",cone_angle=60}"
+#define POINT(pos) "lights[1]={type='point',position=" pos "}"
+
+/* The degenerate configurations of the issue, for directional, spot and
+ * point lights (the view on overhead-plane.lua: the eye at the origin
+ * looking down -z, the ground 0.5 below): light along the view (behind the
+ * eye, ahead of it, at the eye), a light behind the viewer casting onto the
+ * receivers in front (for PSM such a light lies behind the eye's plane: its
+ * post-perspective image is past infinity, and points behind it swap
+ * sides), near 1e-6, far / near 1e6, an empty body, a light grazing the
+ * ground. */
+TEST(test_warp_degenerate_configurations_stay_finite)
+{
+    static const char *const directional[][5] = {
+        {"light along the view", "lights[1].direction={0,0,-1}", NULL, NULL},          /* gamma = 0, light behind */
+        {"light against the view", "lights[1].direction={0,-0.01,1}", NULL, NULL},     /* toward the eye */
+        {"near 1e-6, far 1", "camera.near=0.000001", "camera.far=1", NULL},
+        {"far / near = 1e6", "camera.near=0.0001", "camera.far=100", NULL},
+        {"empty body", "camera.position={0,50,0}", "camera.target={0,60,0}", "camera.up={1,0,0}"}, /* the sky */
+        {"light grazing the ground", "lights[1].direction={0,-0.0001,-1}", NULL, NULL},
+    };
+    static const char *const spot[][5] = {
+        {"behind the viewer, casting ahead", SPOT("{0,3,12}", "{0,-3.5,-52}"), NULL, NULL},
+        {"on the view axis behind the eye", SPOT("{0,0,8}", "{0,0,-1}"), NULL, NULL},
+        {"on the view axis, facing the eye", SPOT("{0,0,-150}", "{0,0,1}"), NULL, NULL},
+        {"at the eye", SPOT("{0,0,0}", "{0,-0.2,-1}"), NULL, NULL},
+        {"near 1e-6, far 1", SPOT("{0,2,-0.5}", "{0,-1,0}"), "camera.near=0.000001", "camera.far=1"},
+        {"far / near = 1e6", SPOT("{0,20,-30}", "{0,-1,0}"), "camera.near=0.0001", "camera.far=100"},
+        {"empty body", SPOT("{0,20,-30}", "{0,-1,0}"), "camera.position={0,50,0}", "camera.target={0,60,0}",
+         "camera.up={1,0,0}"},
+        {"grazing the ground", SPOT("{0,-0.45,20}", "{0,0,-1}"), NULL, NULL},
+    };
+    static const char *const point[][5] = {
+        {"behind the viewer, casting ahead", POINT("{0,3,12}"), NULL, NULL},
+        {"on the view axis behind the eye", POINT("{0,0,8}"), NULL, NULL},
+        {"on the view axis, ahead", POINT("{0,0,-150}"), NULL, NULL},
+        {"at the eye", POINT("{0,0,0}"), NULL, NULL},
+        {"near 1e-6, far 1", POINT("{0,2,-0.5}"), "camera.near=0.000001", "camera.far=1"},
+        {"far / near = 1e6", POINT("{0,20,-30}"), "camera.near=0.0001", "camera.far=100"},
+        {"empty body", POINT("{0,20,-30}"), "camera.position={0,50,0}", "camera.target={0,60,0}",
+         "camera.up={1,0,0}"},
+        {"grazing the ground", POINT("{0,-0.45,20}"), NULL, NULL},
+    };
+    check_cases("directional", directional, (int)(sizeof directional / sizeof directional[0]));
+    check_cases("spot", spot, (int)(sizeof spot / sizeof spot[0]));
+    check_cases("point", point, (int)(sizeof point / sizeof point[0]));
     /* a flat scene: the body has no height */
     Lab *flat = fixture_lab("flat.lua", "return { name = 'flat', camera = { position = {0, 1, 4}, target = {0, 0, 0},"
                                         " width = 64, height = 48 }, lights = { { type = 'directional',"
@@ -169,6 +217,41 @@ TEST(test_warp_degenerate_configurations_stay_finite)
     CHECK(flat);
     check_finite("flat body", flat);
     lab_close(flat);
+}
+
+/* A light behind the viewer casting onto the receivers in front: in the
+ * eye's post-perspective space it lies past infinity (behind the eye's
+ * plane), where Stamminger & Drettakis's map must invert the depth order or
+ * shadows land on the wrong side. Ours is a homography of the light's own
+ * base plane, so PSM is used there as such (no fallback) and classifies as
+ * well as the unwarped perspective map against the truth. */
+TEST(test_warp_psm_with_the_light_behind_the_eye_matches_the_truth)
+{
+    static const char *const lights[] = {SPOT("{0,3,12}", "{0,-3.5,-52}"), POINT("{0,3,12}")};
+    for (int k = 0; k < 2; k++) {
+        const char *ov[] = {SMALL, lights[k]};
+        Lab *lab = open_with("scenes/overhead-plane.lua", ov, 3);
+        CHECK(lab);
+        const char *psm[] = {"fit=body", "map_size=1024", "projection=psm"};
+        const char *flat[] = {"fit=body", "map_size=1024", "projection=perspective"};
+        long wp = misclassified(lab, psm, 3), wf = misclassified(lab, flat, 3);
+        Error err;
+        double p[TECH_MAX_PARAMS];
+        CHECK(params_of(tech_find("sm", &err), psm, 3, p));
+        ShadowMapSpec spec = smap_spec(p);
+        const ShadowMap *m = res_shadow_map(lab_resources(lab), lab_scene(lab), 0, &spec, &err);
+        CHECK(m);
+        const MapFace *f = &m->view.face[0];
+        bool own = f->warp == MAP_WARP_HOMOGRAPHY && f->warp_n == 0.0 && !f->warp_fallback; /* psm_homography's */
+        long samples = (long)lab_scene(lab)->camera.width * lab_scene(lab)->camera.height;
+        printf("    %s light behind the eye: psm %ld misclassified (%s), perspective %ld, of %ld pixels\n",
+               light_kind_name(lab_scene(lab)->lights[0].kind), wp,
+               own ? "its own homography" : "fell back", wf, samples);
+        CHECK(own);
+        CHECK(wp >= 0 && wf >= 0);
+        CHECK_MSG(wp <= wf + 5 && wp * 200 < samples, "psm %ld misclassified, perspective %ld", wp, wf);
+        lab_close(lab);
+    }
 }
 
 TEST(test_aliasing_is_built_only_when_asked_for)
