@@ -13,15 +13,22 @@
 -- every configuration, its "-aux-cascade" map-index image: red, green,
 -- blue for partitions 1, 2, 3; "-aux-m" the error's integer part), plus
 -- partitions.md / partitions.csv: misclassified samples, mean and maximum
--- aliasing error m, per partition count, warp and light.
+-- aliasing error m, per partition count, warp and light; and per light the
+-- aliasing error along the view depth z and its histogram for every
+-- configuration (plots/aliasing-LIGHT-depth.*, plots/aliasing-LIGHT-hist.*;
+-- their data in aliasing/, the format of `shadowlab aliasing`'s
+-- aliasing-depth.csv and aliasing-hist.csv).
 local sl = require "shadowlab"
 local sweep = require "shadowlab.sweep"
 local experiment = require "shadowlab.experiment"
 local report = require "shadowlab.report"
+local aliasing_plots = dofile(sl.root .. "/experiments/lib/aliasing_plots.lua")
+
+local SIZE = { ["camera.width"] = 384, ["camera.height"] = 288 }
 
 local exp = experiment.new{
   name = "fig3-10-12-partitions", samples = 1, repeats = 3, warmup = 1,
-  overrides = { ["camera.width"] = 384, ["camera.height"] = 288 },
+  overrides = SIZE,
   description = "Course Figs. 3.10-3.12: 1 to 3 z-partitions (practical splits, lambda 0.9, fit body_visible) without and with " ..
                 "LiSPSM per partition, map index colour-coded, high sun and sun behind the viewer, nearest " ..
                 "lookups and PCF, on the terrain against the ray-traced truth.",
@@ -29,11 +36,13 @@ local exp = experiment.new{
 -- the sun behind the viewer: camera 30 m up looking down 20 degrees along the sun's direction
 local down = math.rad(20)
 local behind = { math.cos(down) * -0.0995, -math.sin(down), math.cos(down) * -0.995 }
-exp:scene("scenes/terrain.lua", {
-  { ["lights[1].direction"] = { 0.3, -1, 0.2 } },
-  { ["lights[1].direction"] = behind, ["camera.position"] = { 3, 30, 440 },
-    ["camera.target"] = { 3 + 100 * behind[1], 30 + 100 * behind[2], 440 + 100 * behind[3] } },
-})
+local LIGHTS = {
+  { name = "high-sun", label = "high sun", overrides = { ["lights[1].direction"] = { 0.3, -1, 0.2 } } },
+  { name = "behind", label = "sun behind the viewer",
+    overrides = { ["lights[1].direction"] = behind, ["camera.position"] = { 3, 30, 440 },
+                  ["camera.target"] = { 3 + 100 * behind[1], 30 + 100 * behind[2], 440 + 100 * behind[3] } } },
+}
+exp:scene("scenes/terrain.lua", { LIGHTS[1].overrides, LIGHTS[2].overrides })
 local points = sweep.grid{ cascades = { 1, 2, 3 }, projection = { "ortho", "lispsm" }, fit = { "body_visible" },
                            split_scheme = { "practical" }, split_lambda = { 0.9 }, map_size = { 1024 } }
 exp:add("aliasing", points)
@@ -66,6 +75,25 @@ for _, r in ipairs(result.rows) do
   end
 end
 local out = result.out
+
+-- The error along z and its histogram, per light, over the same configurations (the maps are the runs').
+for _, light in ipairs(LIGHTS) do
+  local ov = {}
+  for k, v in pairs(SIZE) do ov[k] = v end
+  for k, v in pairs(light.overrides) do ov[k] = v end
+  local lab <close> = sl.open("scenes/terrain.lua", ov)
+  local set = aliasing_plots.new(out)
+  for _, p in ipairs(points) do
+    local warp = p.projection == "lispsm" and "LiSPSM" or "no warp"
+    set:add(string.format("%d partition%s, %s", p.cascades, p.cascades > 1 and "s" or "", warp),
+            string.format("%s-%d-%s", light.name, p.cascades, p.projection), lab:aliasing{ params = p }.samples)
+  end
+  local d, h = set:draw(out .. "/plots", "aliasing-" .. light.name, "Figs. 3.10-3.12, " .. light.label, lab:info(),
+                        "practical splits (lambda 0.9, fit body_visible), 1024^2 per map")
+  md[#md + 1] = ""
+  md[#md + 1] = string.format("%s: ![error along z](%s) ![histogram](%s)", light.label, d.svg, h.svg)
+end
+
 sl.write_file(out .. "/partitions.csv", table.concat(csv, "\n") .. "\n")
 sl.write_file(out .. "/partitions.md", table.concat(md, "\n") .. "\n")
 print(table.concat(md, "\n"))

@@ -11,24 +11,29 @@
 --                0: the light behind the viewer, along the view; 180: shining toward the viewer) [90]
 --   projection   ortho (uniform) | psm | lispsm | tsm | logpsm [lispsm]
 --   n            the warp's n as a multiple of n_opt = z_n + sqrt(z_f z_n) (lispsm, logpsm) [1]
+--   n_world      a free n in world units instead (0: off; n and falloff then do nothing) [0]
 --   falloff      lloyd | sin_gamma | none: how n grows as gamma shrinks [lloyd]
 --   pseudo_near  compute warps and splits as if z_n were this (0: off) [0]
---   cascades     z-partitions [1];  split  practical | log | uniform | faces [practical];  lambda  [0.5]
+--   cascades     z-partitions [1];  split  practical | log | uniform | explicit | faces [practical];
+--   lambda       [0.5];  split_1, split_2, split_3  explicit split view depths, world units [0: not given]
 --   fit          body | body_visible | view | scene [body]
 -- Writes DIR (default reports/lab-aliasing): the error map (m, Lloyd's colours: green at m = 1, dark red at
 -- m >= 10), the map-index image, the shaded image and its error against the truth (images/), lab.md with
--- the numbers, and sweep.csv when a knob is swept.
+-- the numbers, the error along the view depth z and its histogram (plots/aliasing-depth.*,
+-- plots/aliasing-hist.*; with a sweep, one curve per value in plots/sweep-depth.*, plots/sweep-hist.*;
+-- their data in aliasing/, the format of `shadowlab aliasing`), and sweep.csv when a knob is swept.
 --   Try: gamma=90 projection=ortho, then projection=lispsm (the error moves from the near plane to
 --   everywhere and shrinks); gamma=10 (the warp fades: Lloyd's falloff); cascades=4 split=log;
 --   far=10000 (r = z_f / z_n grows: uniform's error grows like r, LiSPSM's like sqrt(r), log's like ln r);
 --   sweep=n:0.1,0.3,1,3,10,100 (PSM-like to uniform: the product of the two axes' maxima stays put).
 local sl = require "shadowlab"
+local aliasing_plots = dofile(sl.root .. "/experiments/lib/aliasing_plots.lua")
 
 local knobs = { scene = "scenes/overhead-plane.lua", map_size = 1024, gamma = 90, projection = "lispsm", n = 1,
-                falloff = "lloyd", pseudo_near = 0, cascades = 1, split = "practical", lambda = 0.5, fit = "body",
-                out = "reports/lab-aliasing" }
-local numeric = { map_size = true, near = true, far = true, gamma = true, n = true, pseudo_near = true,
-                  cascades = true, lambda = true }
+                n_world = 0, falloff = "lloyd", pseudo_near = 0, cascades = 1, split = "practical", lambda = 0.5,
+                split_1 = 0, split_2 = 0, split_3 = 0, fit = "body", out = "reports/lab-aliasing" }
+local numeric = { map_size = true, near = true, far = true, gamma = true, n = true, n_world = true, pseudo_near = true,
+                  cascades = true, lambda = true, split_1 = true, split_2 = true, split_3 = true }
 local sweep_knob, sweep_values
 for _, a in ipairs(arg) do
   local k, v = a:match("^([%w_]+)=(.+)$")
@@ -53,8 +58,9 @@ local function setting(kn)
   if kn.near then ov["camera.near"] = kn.near end
   if kn.far then ov["camera.far"] = kn.far end
   local params = { map_size = math.tointeger(kn.map_size), projection = kn.projection, warp_n = kn.n,
-                   warp_falloff = kn.falloff, pseudo_near = kn.pseudo_near, cascades = math.tointeger(kn.cascades),
-                   split_scheme = kn.split, split_lambda = kn.lambda, fit = kn.fit }
+                   warp_n_world = kn.n_world, warp_falloff = kn.falloff, pseudo_near = kn.pseudo_near,
+                   cascades = math.tointeger(kn.cascades), split_scheme = kn.split, split_lambda = kn.lambda,
+                   split_1 = kn.split_1, split_2 = kn.split_2, split_3 = kn.split_3, fit = kn.fit }
   return ov, params
 end
 
@@ -69,12 +75,18 @@ local function measure(kn, out)
   local run = lab:compare{ technique = "aliasing", params = params, samples = 1, out = out, png = out ~= nil,
                            exr = false }
   local m = run:record().metrics
-  return a, m.false_shadow + m.false_lit, m.false_shadow, m.false_lit, zn, zf
+  return a, m.false_shadow + m.false_lit, m.false_shadow, m.false_lit, zn, zf, lab:info()
 end
 
 local out = knobs.out
 sl.mkdir(out)
-local a, wrong, fs, fl, zn, zf = measure(knobs, out .. "/images")
+local a, wrong, fs, fl, zn, zf, info = measure(knobs, out .. "/images")
+local here = aliasing_plots.new(out)
+here:add(string.format("%s, %d map%s", knobs.projection, knobs.cascades, knobs.cascades > 1 and "s" or ""), "setting",
+         a.samples)
+local plot_sub = string.format("%s, gamma %g deg, %d^2 per map, z_n = %g, z_f = %g", knobs.projection, knobs.gamma,
+                               knobs.map_size, zn, zf)
+local depth_img, hist_img = here:draw(out .. "/plots", "aliasing", "Aliasing lab", info, plot_sub)
 local md = { "# Shadow-map aliasing lab", "" }
 local settings = {}
 for k, v in pairs(knobs) do if k ~= "out" then settings[#settings + 1] = k .. "=" .. tostring(v) end end
@@ -102,6 +114,8 @@ md[#md + 1] = ""
 md[#md + 1] = "Images: images/aliasing-aux-m.png (m's integer part), images/aliasing-aux-cascade.png (map index), " ..
               "images/aliasing-shaded.png, images/aliasing-error.png (against the truth). For Lloyd's colour map " ..
               "of m run `shadowlab aliasing` with the same parameters."
+md[#md + 1] = ""
+md[#md + 1] = string.format("![error along z](%s) ![histogram](%s)", depth_img.svg, hist_img.svg)
 if sweep_knob then
   local csv = { sweep_knob .. ",misclassified,m_max_samples,m_mean_samples,undersampled_share,storage_factor" }
   md[#md + 1] = ""
@@ -109,17 +123,23 @@ if sweep_knob then
   md[#md + 1] = ""
   md[#md + 1] = "| " .. sweep_knob .. " | misclassified | m max | m mean | undersampled | storage factor |"
   md[#md + 1] = "|---|---:|---:|---:|---:|---:|"
+  local swept, swept_info = aliasing_plots.new(out), info
   for _, v in ipairs(sweep_values) do
     local kn = {}
     for k, x in pairs(knobs) do kn[k] = x end
     kn[sweep_knob] = v
-    local s, w = measure(kn, nil)
+    local s, w, _, _, _, _, at = measure(kn, nil)
+    swept_info = at
+    swept:add(sweep_knob .. "=" .. tostring(v), "sweep-" .. sweep_knob .. "-" .. tostring(v), s.samples)
     csv[#csv + 1] = string.format("%s,%d,%.6g,%.6g,%.6g,%.6g", tostring(v), w, s.samples.m_max, s.samples.m_mean,
                                   s.samples.undersampled_share, s.frustum.storage_factor)
     md[#md + 1] = string.format("| %s | %d | %.4g | %.4g | %.1f %% | %.4g |", tostring(v), w, s.samples.m_max,
                                 s.samples.m_mean, 100 * s.samples.undersampled_share, s.frustum.storage_factor)
   end
   sl.write_file(out .. "/sweep.csv", table.concat(csv, "\n") .. "\n")
+  local d, h = swept:draw(out .. "/plots", "sweep", "Aliasing lab, sweep of " .. sweep_knob, swept_info, plot_sub)
+  md[#md + 1] = ""
+  md[#md + 1] = string.format("![error along z](%s) ![histogram](%s)", d.svg, h.svg)
 end
 sl.write_file(out .. "/lab.md", table.concat(md, "\n") .. "\n")
 print(table.concat(md, "\n"))
