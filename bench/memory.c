@@ -7,8 +7,11 @@
  * child's peak RSS (getrusage's ru_maxrss) against the bytes the resource
  * manager reports holding (rm_bytes: what the records list, the BVH, view
  * samples and classes included), target <= 1.2. The RSS before the scene is
- * loaded (the program and its libraries) is reported beside it. A technique
- * that fails is reported and the others still run (exit status 1 at the end).
+ * loaded (the program and its libraries) is reported beside it. Where a
+ * technique refuses the map size (a resource over its cap) it is measured at
+ * the first of half, a quarter, ... (down to 256) it accepts, the row's note
+ * saying what was refused; a technique that fails otherwise is reported and
+ * the others still run (exit status 1 at the end).
  * Rows: DIR/memory.csv.
  * Usage: memory [-t TECH]... [--res R] [--threads N] [-o DIR] [SCENE] */
 #include <omp.h>
@@ -22,7 +25,7 @@
 
 #define MAX_ITEMS 32
 #define MEMORY_BOUND 1.2
-#define HEADER "technique,map_res,peak_rss_mib,resources_mib,ratio,bound,within,baseline_rss_mib,scene,light," \
+#define HEADER "technique,map_res,peak_rss_mib,resources_mib,ratio,bound,within,baseline_rss_mib,note,scene,light," \
                BENCH_TAIL_HEADER "\n"
 
 typedef struct Options {
@@ -45,7 +48,7 @@ static double peak_kib(void)
 }
 
 /* In the child: load, render once, measure. */
-static Usage child_run(const Options *o, const Technique *t)
+static Usage child_run(const Options *o, const Technique *t, int res)
 {
     Usage u = {.baseline_kib = peak_kib()};
     Error err = {0};
@@ -53,10 +56,10 @@ static Usage child_run(const Options *o, const Technique *t)
     tech_params_default(t, params);
     int size = tech_param_index(t, "map_size"), proj = tech_param_index(t, "projection");
     if (size < 0) {
-        snprintf(u.error, sizeof u.error, "no map_size parameter to set to %d", o->res);
+        snprintf(u.error, sizeof u.error, "no map_size parameter to set to %d", res);
         return u;
     }
-    params[size] = o->res;
+    params[size] = res;
     if (proj >= 0) params[proj] = MAP_PROJ_PERSPECTIVE; /* one face: a sphere light's default may be a six-face cube */
     Lab *lab = bench_lab_open(o->scene, t, NULL, 0, &u.light, &err);
     RenderRequest req = {.tech = t, .params = params, .light_index = 0, .repeat = 1};
@@ -72,7 +75,9 @@ static Usage child_run(const Options *o, const Technique *t)
     return u;
 }
 
-static bool measure(const Options *o, const Technique *t, Usage *u, Error *err)
+/* One child at map size `res`; false with *refused set where the technique
+ * refused the render (its message in u->error), unset where the child failed. */
+static bool measure(const Options *o, const Technique *t, int res, Usage *u, bool *refused, Error *err)
 {
     int fd[2];
     if (pipe(fd) != 0) return error_set(err, "pipe failed");
@@ -81,7 +86,7 @@ static bool measure(const Options *o, const Technique *t, Usage *u, Error *err)
     if (pid < 0) return error_set(err, "fork failed");
     if (pid == 0) {
         close(fd[0]);
-        Usage c = child_run(o, t);
+        Usage c = child_run(o, t, res);
         ssize_t w = write(fd[1], &c, sizeof c);
         _exit(w == (ssize_t)sizeof c ? 0 : 1);
     }
@@ -90,27 +95,38 @@ static bool measure(const Options *o, const Technique *t, Usage *u, Error *err)
     close(fd[0]);
     int status;
     waitpid(pid, &status, 0);
+    *refused = false;
     if (n != (ssize_t)sizeof *u || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
         return error_set(err, "%s: the measuring child failed", t->name);
-    if (u->error[0]) return error_set(err, "%s: %s", t->name, u->error);
-    return true;
+    *refused = u->error[0] != '\0';
+    return !*refused || error_set(err, "%s", u->error);
 }
 
+/* The technique at --res, or where it refuses that, at the first of half,
+ * a quarter, ... (down to 256) that it accepts. */
 static bool bench_tech(const Options *o, const Technique *t, Error *err)
 {
     Usage u;
-    if (!measure(o, t, &u, err)) return false;
-    double peak = u.peak_kib / 1024.0, res = u.resources_bytes / 1048576.0, ratio = peak / res;
+    bool refused;
+    char note[400] = "";
+    int res = o->res;
+    while (!measure(o, t, res, &u, &refused, err)) {
+        if (!refused || res / 2 < 256) return false;
+        if (!note[0]) bench_csv_field(note, sizeof note, err->msg);
+        printf("  %-16s %d^2 REFUSED (%s); trying %d^2\n", t->name, res, err->msg, res / 2);
+        res /= 2;
+    }
+    double peak = u.peak_kib / 1024.0, bytes = u.resources_bytes / 1048576.0, ratio = peak / bytes;
     bool within = ratio <= MEMORY_BOUND;
     printf("  %-16s %d^2 (light 1: %s): peak RSS %8.1f MiB, resources %8.1f MiB, ratio %.3f (bound %.1f; %.1f MiB "
-           "before loading)%s\n", t->name, o->res, u.light.text, peak, res, ratio, MEMORY_BOUND,
+           "before loading)%s\n", t->name, res, u.light.text, peak, bytes, ratio, MEMORY_BOUND,
            u.baseline_kib / 1024.0, within ? "" : "  OVER");
-    char row[1024], tail[512], path[4096], light[200], scene[300];
+    char row[2048], tail[512], path[4096], light[200], scene[300];
     bench_tail(tail, sizeof tail, o->threads);
     bench_csv_field(light, sizeof light, u.light.text);
     bench_csv_field(scene, sizeof scene, o->scene);
-    snprintf(row, sizeof row, "%s,%d,%.2f,%.2f,%.3f,%.1f,%s,%.2f,%s,%s,%s\n", t->name, o->res, peak, res, ratio,
-             MEMORY_BOUND, within ? "yes" : "no", u.baseline_kib / 1024.0, scene, light, tail);
+    snprintf(row, sizeof row, "%s,%d,%.2f,%.2f,%.3f,%.1f,%s,%.2f,%s,%s,%s,%s\n", t->name, res, peak, bytes, ratio,
+             MEMORY_BOUND, within ? "yes" : "no", u.baseline_kib / 1024.0, note, scene, light, tail);
     snprintf(path, sizeof path, "%s/memory.csv", o->dir);
     return bench_csv_append(path, HEADER, row, err);
 }

@@ -77,7 +77,7 @@ plot "
             first=1
             for t in $(column "$dir/growth.csv" technique | sort -u); do
                 column "$dir/growth.csv" technique axis value frame_ms |
-                    awk -v t="$t" -v a="$axis" '$1 == t && $2 == a { print $3, $4 }' > "$dir/growth_${axis}_$t.dat"
+                    awk -v t="$t" -v a="$axis" '$1 == t && $2 == a && NF == 4 { print $3, $4 }' > "$dir/growth_${axis}_$t.dat"
                 [ -s "$dir/growth_${axis}_$t.dat" ] || { rm -f "$dir/growth_${axis}_$t.dat"; continue; }
                 [ $first = 1 ] || script="$script, "
                 script="$script'$dir/growth_${axis}_$t.dat' using 1:2 with linespoints title '$t'"
@@ -92,7 +92,7 @@ plot "
         first=1
         for t in $(column "$dir/growth.csv" technique | sort -u); do
             column "$dir/growth.csv" technique axis value frame_ms |
-                awk -v t="$t" '$1 == t && $2 != "map_size" && $2 != "triangles" && $2 != "image_width" {
+                awk -v t="$t" '$1 == t && NF == 4 && $2 != "map_size" && $2 != "triangles" && $2 != "image_width" {
                     if (!v0) { v0 = $3; f0 = $4; name = $2 } print $3 / v0, $4 / f0, name }' > "$dir/growth_main_$t.dat"
             [ -s "$dir/growth_main_$t.dat" ] || { rm -f "$dir/growth_main_$t.dat"; continue; }
             p=$(awk 'NR == 1 { print $3 }' "$dir/growth_main_$t.dat")
@@ -157,7 +157,7 @@ plot x with lines dashtype 2 title 'ideal'"
     echo "![main parameter](growth_main.svg) ![map size](growth_map_size.svg)"
     echo "![triangles](growth_triangles.svg) ![image size](growth_image_width.svg)"
     echo
-    table growth.csv technique axis value frame_ms eval_ms build_ms resources_built light threads load_1min
+    table growth.csv technique axis value frame_ms eval_ms build_ms resources_built note light threads load_1min
     echo "Constant time in K with summed-area tables (target: largest K within 1.2x of the smallest):"
     echo
     table constant_time.csv technique settings prefilter K_min K_max frame_min_ms frame_max_ms ratio within light threads load_1min
@@ -173,7 +173,7 @@ plot x with lines dashtype 2 title 'ideal'"
     table threads_eval.csv technique threads ms_1 ms_n speedup light width height load_1min
     echo "## 6. Peak memory, 4096^2 maps (target <= 1.2)"
     echo
-    table memory.csv technique map_res peak_rss_mib resources_mib ratio within baseline_rss_mib light load_1min
+    table memory.csv technique map_res peak_rss_mib resources_mib ratio within baseline_rss_mib note light load_1min
     echo "## 7. Start-up (target: no OpenImageIO, first line under 20 ms)"
     echo
     table startup.csv command first_line_ms exit_ms loads_openimageio within load_1min

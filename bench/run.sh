@@ -26,8 +26,9 @@ current=
 step() { current=$1; echo; echo "== $* (load: $(cut -d' ' -f1-3 /proc/loadavg))"; }
 
 # run PROGRAM ARGS...: a failure is reported and recorded, and the run goes on.
+# stdout line-buffered, so a program's errors land between its lines, not in them.
 run() {
-    "$@" && return 0
+    stdbuf -oL "$@" && return 0
     rc=$?
     failures=$((failures + 1))
     echo "run.sh: step $current: FAILED (exit $rc): $*" >&2

@@ -33,7 +33,7 @@
 #define CONSTANT_BOUND 1.2
 /* Every row: ..., scene, light, settings, width, height, then bench_tail's columns. */
 #define WHERE_HEADER "scene,light,settings,width,height," BENCH_TAIL_HEADER "\n"
-#define GROWTH_HEADER "technique,axis,value,frame_ms,eval_ms,build_ms,resources_built," WHERE_HEADER
+#define GROWTH_HEADER "technique,axis,value,frame_ms,eval_ms,build_ms,resources_built,note," WHERE_HEADER
 #define CONSTANT_HEADER "technique,prefilter,K_min,K_max,frame_min_ms,frame_max_ms,ratio,bound,within," WHERE_HEADER
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup," WHERE_HEADER
 
@@ -51,6 +51,7 @@ typedef struct Subject {
     double params[TECH_MAX_PARAMS];
     char settings[256]; /* the -p assignments it has, or "defaults" */
     BenchLight light;
+    int refused;        /* growth points the technique refused (growth_point) */
 } Subject;
 
 /* One measured configuration. */
@@ -204,30 +205,39 @@ static int param_values(const ParamDesc *p, double *v)
     return n;
 }
 
-static bool growth_row(const Options *o, const Subject *sj, const char *axis, double value, const Point *p,
-                       const Scene *sc, Error *err)
+/* One point of a growth curve: measured, or refused by the technique (a
+ * resource over its cap, say), which is printed and kept in the row's note
+ * with empty timings; only a failure to write the row is an error. */
+static bool growth_point(const Options *o, Lab *lab, Subject *sj, const double *params, const char *axis,
+                         double value, Error *err)
 {
-    char row[2048], end[1024];
-    where(sj, sc, o->c.threads, end, sizeof end);
-    snprintf(row, sizeof row, "%s,%s,%g,%.4f,%.4f,%.4f,%d,%s", sj->t->name, axis, value, p->frame_s * 1e3,
-             p->eval_s * 1e3, p->build_s * 1e3, p->built, end);
-    printf("  %-18s %-16s %10g: frame %9.3f ms, eval %9.3f ms, build %9.3f ms\n", sj->t->name, axis, value,
-           p->frame_s * 1e3, p->eval_s * 1e3, p->build_s * 1e3);
+    char row[4096], end[1024], note[1100] = "", timings[160];
+    Point p;
+    Error refusal;
+    if (measure(lab, sj->t, params, o->c.repeat, &p, &refusal)) {
+        snprintf(timings, sizeof timings, "%.4f,%.4f,%.4f,%d", p.frame_s * 1e3, p.eval_s * 1e3, p.build_s * 1e3,
+                 p.built);
+        printf("  %-18s %-16s %10g: frame %9.3f ms, eval %9.3f ms, build %9.3f ms\n", sj->t->name, axis, value,
+               p.frame_s * 1e3, p.eval_s * 1e3, p.build_s * 1e3);
+    } else {
+        snprintf(timings, sizeof timings, ",,,");
+        bench_csv_field(note, sizeof note, refusal.msg);
+        printf("  %-18s %-16s %10g: REFUSED: %s\n", sj->t->name, axis, value, refusal.msg);
+        sj->refused++;
+    }
+    where(sj, lab_scene(lab), o->c.threads, end, sizeof end);
+    snprintf(row, sizeof row, "%s,%s,%g,%s,%s,%s", sj->t->name, axis, value, timings, note, end);
     return append(o, "growth.csv", GROWTH_HEADER, row, err);
 }
 
 /* A technique parameter swept in one Lab (its resources reused where keys allow). */
-static bool growth_param(const Options *o, Lab *lab, const Subject *sj, int index, const double *values, int n,
-                         Error *err)
+static bool growth_param(const Options *o, Lab *lab, Subject *sj, int index, const double *values, int n, Error *err)
 {
     double params[TECH_MAX_PARAMS];
     memcpy(params, sj->params, sizeof params);
     for (int i = 0; i < n; i++) {
         params[index] = values[i];
-        Point p;
-        if (!measure(lab, sj->t, params, o->c.repeat, &p, err) ||
-            !growth_row(o, sj, sj->t->params[index].name, values[i], &p, lab_scene(lab), err))
-            return false;
+        if (!growth_point(o, lab, sj, params, sj->t->params[index].name, values[i], err)) return false;
     }
     return true;
 }
@@ -242,10 +252,8 @@ static bool growth_scene(const Options *o, Subject *sj, const char *axis, const 
         snprintf(b, sizeof b, "camera.height=%d", values[i] * 3 / 4);
         const char *ov[] = {a, b};
         Lab *lab = open_lab(o, sj, ov, strcmp(axis, "image_width") == 0 ? 2 : 1, err);
-        Point p;
-        bool ok = lab && measure(lab, sj->t, sj->params, o->c.repeat, &p, err) &&
-                  growth_row(o, sj, axis, strcmp(axis, "triangles") == 0 ? lab_scene(lab)->num_triangles : values[i],
-                             &p, lab_scene(lab), err);
+        bool ok = lab && growth_point(o, lab, sj, sj->params, axis,
+                                      strcmp(axis, "triangles") == 0 ? lab_scene(lab)->num_triangles : values[i], err);
         lab_close(lab);
         if (!ok) return false;
     }
@@ -403,6 +411,7 @@ static bool bench_technique(const Options *o, const Technique *t)
     if (ok && part(o, "growth")) ok = growth(o, &sj, &err);
     if (ok && part(o, "constant") && has_sat(t)) ok = constant_time(o, &sj, &err);
     if (ok && part(o, "threads")) ok = scaling(o, &sj, &err);
+    if (sj.refused) printf("%s: %d growth point(s) REFUSED (growth.csv's note column says why)\n", t->name, sj.refused);
     if (!ok) fprintf(stderr, "techniques: %s: FAILED: %s\n", t->name, err.msg);
     return ok;
 }
