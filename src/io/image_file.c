@@ -1,7 +1,8 @@
 /* image_file.c -- image files through the OpenImageIO plugin: locating and
  * dlopening it once, 8-bit (s)RGB encoding for output, linearisation of
- * display formats on input, and atomic writes via same-extension temporaries
- * (OIIO picks the format from the extension). */
+ * display formats on input (after image_check.c's structural checks, into
+ * an Image the plugin decodes straight into), and atomic writes via
+ * same-extension temporaries (OIIO picks the format from the extension). */
 #define _POSIX_C_SOURCE 200809L
 #include "io/image_file.h"
 #include <dlfcn.h>
@@ -16,6 +17,7 @@
 #include <strings.h>
 #include <unistd.h>
 #include "core/fsutil.h"
+#include "io/image_check.h"
 #include "io/oiio_plugin.h"
 
 #define PLUGIN_FILE "libshadowlab_oiio.so"
@@ -207,20 +209,27 @@ bool image_write_ldr(const char *path, const Image *img, bool srgb, Error *err)
     return rename_into_place(tmp, path, err);
 }
 
+/* OiioPixelAlloc: the Image (ctx) sized by image_init, whose limits apply. */
+static float *alloc_image(void *ctx, int w, int h, int channels, char *msg, int n)
+{
+    Image *img = ctx;
+    Error err;
+    if (image_init(img, w, h, channels, &err)) return img->data;
+    snprintf(msg, (size_t)n, "%s", err.msg);
+    return NULL;
+}
+
 bool image_read(const char *path, Image *img, Error *err)
 {
     *img = (Image){0};
+    if (!image_file_check(path, err)) return false;
     const OiioPluginApi *api = plugin_get(path, "PNG/JPEG input", err);
     if (!api) return false;
-    int w = 0, h = 0, c = 0;
-    float *px = NULL;
     char msg[ERROR_MSG_MAX];
-    if (api->read_float(path, &w, &h, &c, &px, msg, (int)sizeof msg) != 0)
+    if (api->read_float(path, alloc_image, img, msg, (int)sizeof msg) != 0) {
+        image_free(img);
         return error_set(err, "%s: %s", path, msg);
-    bool ok = image_init(img, w, h, c, err);
-    if (ok) memcpy(img->data, px, image_count(img) * sizeof(float));
-    api->free_pixels(px);
-    if (!ok) return error_prefix(err, "%s: ", path);
+    }
     if (is_srgb_format(path)) linearise(img);
     return true;
 }

@@ -17,8 +17,12 @@
  * extension, renamed into place), so a failure leaves no file. */
 bool image_write_ldr(const char *path, const Image *img, bool srgb, Error *err);
 
-/* Read any image OpenImageIO can read into a float Image, channels as stored.
- * Files of the display formats (.png, .jpg, .jpeg, .bmp, .gif, .tga, .ppm,
+/* Read an image into a float Image, channels as stored, with the
+ * OpenImageIO reader its extension names (no other reader is tried: a
+ * ".png" that is not a PNG is refused). Empty, truncated or corrupt files
+ * are refused with a message naming the file, also where the decoder would
+ * fill in the missing pixels; sizes beyond image_init's limits are refused
+ * before any pixel is decoded. Files of the display formats (.png, .jpg, .jpeg, .bmp, .gif, .tga, .ppm,
  * .pgm, .pnm, .webp) are taken as sRGB-encoded and their colour channels
  * linearised; alpha (2nd of 2 or 4th of 4 channels) stays as stored and
  * straight. Other formats (.exr, .hdr, .tif, ...) are returned as stored. On

@@ -10,8 +10,12 @@
 extern "C" {
 #endif
 
-#define OIIO_PLUGIN_ABI 1
+#define OIIO_PLUGIN_ABI 2
 #define OIIO_PLUGIN_ENTRY "shadowlab_oiio_plugin"
+
+/* Destination for a decoded image of w x h x channels floats, or NULL with
+ * a message in err (size err_len). */
+typedef float *(*OiioPixelAlloc)(void *ctx, int w, int h, int channels, char *err, int err_len);
 
 typedef struct OiioPluginApi {
     int abi;
@@ -21,12 +25,16 @@ typedef struct OiioPluginApi {
      * err (size err_len). */
     int (*write_u8)(const char *path, int w, int h, int channels, const unsigned char *pixels,
                     char *err, int err_len);
-    /* Read any image OIIO can read, converted to float, channels and values
-     * as stored (alpha not premultiplied into colour). *pixels is allocated
-     * by the plugin; release it with free_pixels. */
-    int (*read_float)(const char *path, int *w, int *h, int *channels, float **pixels,
-                      char *err, int err_len);
-    void (*free_pixels)(float *pixels);
+    /* Read an image with the reader its extension names (OIIO's fallback of
+     * trying every other reader is off: a ".png" is decoded as PNG or
+     * refused), converted to float, channels and values as stored (alpha not
+     * premultiplied into colour). Once the header is read, alloc(ctx, w, h,
+     * channels, err, err_len) supplies the destination (interleaved, rows
+     * top to bottom): it enforces the caller's size limits and returns NULL
+     * with a message to refuse. A decode that completes with a warning (a
+     * truncated JPEG, its missing rows filled with grey) fails too. Returns
+     * 0 on success, else a one-line message in err. */
+    int (*read_float)(const char *path, OiioPixelAlloc alloc, void *ctx, char *err, int err_len);
 } OiioPluginApi;
 
 /* The exported symbol (named by OIIO_PLUGIN_ENTRY). */
