@@ -162,6 +162,22 @@ static void quick_caps(const StabJob *j, double *vals)
     }
 }
 
+/* Index of the technique's "precision" choice "f32", or -1 (value in *f32). */
+static int precision_param(const Technique *t, double *f32)
+{
+    int i = tech_param_index(t, "precision");
+    if (i < 0 || t->params[i].type != PARAM_ENUM) return -1;
+    for (int c = 0; t->params[i].choices[c]; c++)
+        if (!strcmp(t->params[i].choices[c], "f32")) {
+            *f32 = c;
+            return i;
+        }
+    return -1;
+}
+
+/* The float32 probes are about float32: where the technique has a precision
+ * parameter (default f64 for moment maps) they also set it to f32, so the
+ * limit is tested in the arithmetic it is a limit of. */
 static bool probe_params(const StabJob *j, double *vals, StabResult *r)
 {
     tech_params_default(j->tech, vals);
@@ -171,7 +187,14 @@ static bool probe_params(const StabJob *j, double *vals, StabResult *r)
     double v = stab_probe_value(p, j->probe);
     Error e;
     if (!tech_param_set(j->tech, p->name, v, vals, &e)) return fail(r, "value at the bound was refused: %s", e.msg);
-    note(r, "%s = %.9g. ", p->name, v);
+    note(r, "%s = %.9g", p->name, v);
+    double f32;
+    int q = is_fp32_probe(j->probe) ? precision_param(j->tech, &f32) : -1;
+    if (q >= 0) {
+        vals[q] = f32;
+        note(r, ", %s = f32", j->tech->params[q].name);
+    }
+    note(r, ". ");
     return true;
 }
 

@@ -1,7 +1,8 @@
 /* selftest.c -- the stability suite's own test binary (make test builds it
  * with ASan + UBSan). First it proves the harness catches what it claims to:
  * techniques that are not in the registry and misbehave on purpose (NaN,
- * out of range, crash, hang, heap overflow, leak, wrong limit, refusals)
+ * out of range, crash, hang, heap overflow, leak, wrong limits, refusals,
+ * a float32 limit reached only in f32 arithmetic)
  * must each give the failed row, and light kinds a technique does not handle
  * must give "not applicable". Then it runs the matrix in quick
  * mode for `hard` and the engine's input cases, under the sanitizers.
@@ -21,7 +22,8 @@
 typedef enum Misbehaviour {
     OK_HALF, GIVES_NAN, GIVES_1_5, CRASHES, HANGS, OVERFLOWS, LEAKS, REFUSES, ALWAYS_LIT,
     NAN_UNLESS_CAPPED, /* 0.5 while map_res is at most STAB_QUICK_TEXELS, else NaN */
-    NAN_NEAR_88        /* 0.5, but NaN while gain is in (80, 90): exp overflowing float32 */
+    NAN_NEAR_88,       /* 0.5, but NaN while gain is in (80, 90): exp overflowing float32 */
+    NAN_NEAR_88_IN_F32 /* the same, only with precision = f32 (its default is f64) */
 } Misbehaviour;
 
 static Misbehaviour current;
@@ -45,10 +47,12 @@ static void fake_evaluate(const void *state, const TechContext *ctx, int begin, 
 {
     (void)state;
     static const float values[] = {[OK_HALF] = 0.5f, [GIVES_1_5] = 1.5f, [ALWAYS_LIT] = 1.0f,
-                                   [NAN_UNLESS_CAPPED] = 0.5f, [NAN_NEAR_88] = 0.5f};
+                                   [NAN_UNLESS_CAPPED] = 0.5f, [NAN_NEAR_88] = 0.5f, [NAN_NEAR_88_IN_F32] = 0.5f};
     bool capped = ctx->params[2] <= STAB_QUICK_TEXELS, near_88 = ctx->params[3] > 80 && ctx->params[3] < 90;
+    bool f32 = ctx->params[4] == 1.0;
     for (int s = begin; s < end; s++) {
-        bool nan = current == GIVES_NAN || (current == NAN_UNLESS_CAPPED && !capped) || (current == NAN_NEAR_88 && near_88);
+        bool nan = current == GIVES_NAN || (current == NAN_UNLESS_CAPPED && !capped) ||
+                   (current == NAN_NEAR_88 && near_88) || (current == NAN_NEAR_88_IN_F32 && near_88 && f32);
         float v = nan ? NAN : values[current];
         if (current == CRASHES) raise(SIGSEGV);
         if (current == OVERFLOWS) {
@@ -60,18 +64,20 @@ static void fake_evaluate(const void *state, const TechContext *ctx, int begin, 
     }
 }
 
+static const char *const fake_precisions[] = {"f64", "f32", NULL};
 static const ParamDesc fake_params[] = {
     {"weight", PARAM_FLOAT, 0.5, 0.0, 1.0, "", "a float parameter", NULL},
     {"taps", PARAM_INT, 4, 1, 64, "texels", "an int parameter", NULL},
     {"map_res", PARAM_INT, 1024, 1, 4096, "texels", "a map resolution (capped in quick runs)", NULL},
     {"gain", PARAM_FLOAT, 1, 0, 100, "", "an exponent, probed at float32's limits", NULL},
+    {"precision", PARAM_ENUM, 0, 0, 1, "", "arithmetic of the maps", fake_precisions},
 };
 static const char *const no_resources[] = {NULL};
 
 static Technique fake(const char *name, unsigned lights)
 {
     return (Technique){.name = name, .family = "test", .source = "selftest", .summary = "misbehaves on purpose",
-                       .params = fake_params, .num_params = 4, .resources = no_resources, .rgb = true,
+                       .params = fake_params, .num_params = 5, .resources = no_resources, .rgb = true,
                        .lights = lights, .prepare = fake_prepare, .evaluate = fake_evaluate, .release = NULL};
 }
 
@@ -164,6 +170,9 @@ static void selftests(void)
     expect("harness_quick_probes_the_cap_itself", NAN_UNLESS_CAPPED, all, "param_map_res", STAB_FAIL, "max: ");
     expect("harness_probes_float32_exp_limits", NAN_NEAR_88, all, "param_gain_at_88", STAB_FAIL, "non-finite");
     expect("harness_quick_probes_float32_exp_limits", NAN_NEAR_88, all, "param_gain", STAB_FAIL, "at_88.72: ");
+    expect("harness_float32_probes_run_in_f32", NAN_NEAR_88_IN_F32, all, "param_gain_at_88", STAB_FAIL, "non-finite");
+    expect("harness_checks_the_umbra_limit", ALWAYS_LIT, LIGHT_BIT(LIGHT_POINT), "light_inside_occluder", STAB_FAIL,
+           "leaks out of the closed box");
     expect_shared_preparation();
 }
 

@@ -4,7 +4,8 @@
  * occluder parallel to a planar receiver; on overlap.lua VSM leaks light
  * where PCF does not, by the closed form f(1-f)D^2 / (f(1-f)D^2 + (d-mu)^2);
  * ESM with c = 80 and 200 stays finite with f32 and f64 box blurs and SATs
- * (where a naive f32 sum overflows); an f32 SAT loses MSM's moments where
+ * (where a naive f32 sum overflows); EVSM in f32 at and above its exponent
+ * limits (42, 44.36, 88.72, 350) stays finite; an f32 SAT loses MSM's moments where
  * an f64 one keeps them; a sweep over K builds one moment map
  * and one SAT; and nothing is NaN, Inf or outside [0, 1] on contact.lua,
  * at the defaults and at the parameters' bounds. The comparisons with the
@@ -269,6 +270,54 @@ TEST(test_esm_large_exponents_stay_finite_in_f32_and_f64)
                 render_result_free(&r);
             }
     printf("    naive f32 sum of exp(80 u): inf; esm c = 80, 200 x box/sat x f64/f32 x 4 classifiers: all finite\n");
+    lab_close(lab);
+}
+
+/* ---- EVSM in float32 at and above its exponent limits ---- */
+
+/* EVSM with precision=f32 (the stability probes' defaults keep f64) at the
+ * catalogue's fp32 limit c = 42 (course §4.2.4), at ln(FLT_MAX) / 2 = 44.36
+ * where exp(2 c u) of an unscaled second moment overflows, at ln(FLT_MAX) =
+ * 88.72 and at the range's maximum 350, on either warp, with box blurs and
+ * SATs: the moments are stored scaled by exp(-c) (evsm's doc), so every
+ * value the range accepts stays finite and in [0, 1]. Below the limit f32
+ * must also agree with f64 (nothing has underflowed there yet). */
+TEST(test_evsm_f32_at_and_above_its_exponent_limits_stays_finite)
+{
+    Lab *lab = filtered_open("scenes/contact.lua", 160, 120);
+    CHECK(lab);
+    static const char *const exponents[] = {"42", "44.36", "88.72", "350"};
+    static const char *const prefilters[] = {"box", "sat"};
+    static const char *const warps[] = {"positive", "both"};
+    int runs = 0;
+    for (int e = 0; e < 4; e++)
+        for (int f = 0; f < 2; f++)
+            for (int w = 0; w < 2; w++)
+                for (int which = 0; which < 2; which++) {
+                    char p[256];
+                    snprintf(p, sizeof p, "map_size=512 K=9 precision=f32 prefilter=%s warps=%s %s=%s", prefilters[f],
+                             warps[w], which ? "exponent_neg" : "exponent_pos", exponents[e]);
+                    RenderResult r;
+                    CHECK(filtered_render(lab, "evsm", p, &r));
+                    long bad = bad_samples(lab, &r.visibility);
+                    CHECK_MSG(bad == 0, "evsm %s: %ld samples NaN, Inf or outside [0, 1]", p, bad);
+                    if (e == 0 && f == 0 && which == 0) {
+                        RenderResult r64;
+                        snprintf(p, sizeof p, "map_size=512 K=9 precision=f64 prefilter=box warps=%s exponent_pos=42",
+                                 warps[w]);
+                        CHECK(filtered_render(lab, "evsm", p, &r64));
+                        Diff d = compare_images(lab, &r.visibility, &r64.visibility);
+                        printf("    evsm c+ = 42, warps=%s, box: mean |f32 - f64| = %.2g, max %.2g over %ld samples\n",
+                               warps[w], d.mean_abs, d.max_abs, d.candidates);
+                        CHECK_MSG(d.candidates > 0 && d.mean_abs < 1e-3, "f32 and f64 differ by %.3g at c = 42",
+                                  d.mean_abs);
+                        render_result_free(&r64);
+                    }
+                    render_result_free(&r);
+                    runs++;
+                }
+    printf("    evsm precision=f32, c = 42, 44.36, 88.72, 350 x box/sat x positive/both x c+/c-: %d runs, all "
+           "finite in [0, 1]\n", runs);
     lab_close(lab);
 }
 
