@@ -128,13 +128,15 @@ static void add_job(Runner *rn, const Technique *t, const StabCase *c, int param
 
 /* ---- scene files --------------------------------------------------------------- */
 
+/* Atomically (core/fsutil.h): a run killed while `stability -o` writes a
+ * case's files leaves the previous file or the whole new one. */
 static bool write_bytes(const char *path, const void *data, size_t n, Error *err)
 {
-    FILE *fp = fopen(path, "wb");
-    if (!fp) return error_set(err, "%s: cannot write: %s", path, strerror(errno));
-    bool ok = fwrite(data, 1, n, fp) == n;
-    ok = fclose(fp) == 0 && ok;
-    return ok || error_set(err, "%s: write failed", path);
+    AtomicFile af;
+    if (!atomic_open(&af, path, err)) return false;
+    if (fwrite(data, 1, n, af.fp) == n) return atomic_commit(&af, err);
+    atomic_abort(&af);
+    return error_set(err, "%s: write failed: %s", path, strerror(errno));
 }
 
 /* A 4 x 4 RGB light image: a gradient in [0.2, 1], texel (1, 2) = f->exr_texel. */

@@ -4,8 +4,10 @@
 # previous version or a complete new one, byte for byte (EXR, PNG) or a
 # whole JSON record; then runs of `reference` are killed while they compute
 # and cache new references, and every cache entry they left must read back
-# as a hit, never as a corrupt entry. Leftover temporaries of killed runs
-# are counted, not failed (a killed process cannot remove them).
+# as a hit, never as a corrupt entry; then `stability -o` is killed while it
+# writes its cases' scene files, and each file left must be whole. Leftover
+# temporaries of killed runs are counted, not failed (a killed process
+# cannot remove them).
 # Usage: tests/stability/atomic.sh build/shadowlab [KILLS]. Prints "atomic: N passed, N failed".
 set -u
 SL=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
@@ -85,6 +87,30 @@ for k in $(seq 1 "$((KILLS / 2))"); do
 done
 if [ "$corrupt" -eq 0 ]; then ok "atomic_reference_cache_never_corrupt"; else no atomic_reference_cache_never_corrupt "$corrupt corrupt entries"; fi
 
-echo "atomic kills: a full run takes $full s, $KILLS kills, $leftovers temporaries left by killed runs"
+# `stability -o` killed while it writes its cases' files (scene.lua, meshes,
+# light images): every file it left is byte for byte the one an uninterrupted
+# run writes (the scene text is deterministic); temporaries are counted.
+STAB="stability -t hard --quick --case zero_area_triangles"
+compare_full=$full
+"$SL" $STAB -o "$TMP/stab-whole" >/dev/null 2>&1 || no atomic_stability_setup "stability failed"
+start=$(date +%s.%N)
+"$SL" $STAB -o "$TMP/stab-time" >/dev/null 2>&1
+full=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.3f", b - a }')
+torn=""
+whole=$(cd "$TMP/stab-whole/scenes" && find . -type f | wc -l)
+for k in $(seq 1 "$KILLS"); do
+    kill_after "$SL" $STAB -o "$TMP/stab-out"
+    [ -d "$TMP/stab-out/scenes" ] || continue
+    for p in $(cd "$TMP/stab-out/scenes" && find . -type f); do
+        case $p in
+        *.tmp*) leftovers=$((leftovers + 1)); rm -f "$TMP/stab-out/scenes/$p" ;;
+        *) cmp -s "$TMP/stab-out/scenes/$p" "$TMP/stab-whole/scenes/$p" || torn="$torn $k:$p" ;;
+        esac
+    done
+done
+if [ "$whole" -ge 4 ] && [ -z "$torn" ]; then ok "atomic_stability_scene_files_after_${KILLS}_kills"
+else no atomic_stability_scene_files "$whole files in a whole run; torn:$torn"; fi
+
+echo "atomic kills: a full compare takes $compare_full s, a stability run $full s, $KILLS kills each, $leftovers temporaries left by killed runs"
 echo "atomic: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
