@@ -105,9 +105,9 @@ test-unit: all $(B)/test_unit
 demo: all
 	./scripts/demo.sh $(B)/shadowlab reports/demo
 
-# The technique reference is generated from the registry.
+# The technique reference and the README's technique table are generated from the registry.
 docs: all
-	./$(B)/shadowlab list --markdown > docs/techniques.md
+	./scripts/docs.sh $(B)/shadowlab
 
 bench: all
 	$(MAKE) -C bench

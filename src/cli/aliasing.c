@@ -7,43 +7,31 @@
 #include <stdlib.h>
 #include <string.h>
 #include "cli/cli.h"
+#include "core/progress.h"
 #include "core/timer.h"
 #include "lab/aliasing_report.h"
 #include "techniques/smap.h"
 
 #define AXIS_POINTS 64 /* view depths of the axis profile, log spaced over near..far */
 
-static const char *const help_text =
-    "usage: shadowlab aliasing SCENE [options]\n"
-    "  -t, --technique NAME   a shadow-map technique whose map is analysed (default aliasing)\n"
-    "  -p, --param K=V        its parameters (repeatable): map_size, projection, fit, warp_n, cascades, ...\n"
-    "  -s, --set KEY=V        scene override (repeatable)\n"
-    "  -l, --light N          light number (default 1)\n"
-    "  --frustum N            also Lloyd's measure over the view frustum at N x N image points x N depths\n"
-    "                         (perspective aliasing only; default 24, 0: off)\n"
-    "  --threads N            worker threads\n"
-    "  -o, --out DIR          output folder (default reports/SCENE-NAME)\n"
-    "  --no-png               skip the PNGs\n"
+static const CliAccept aliasing_options[] = {
+    {OPT_TECHNIQUE, "a shadow-map technique whose map is analysed (default aliasing)"},
+    {OPT_PARAM, "its parameters (repeatable): map_size, projection, fit, warp_n, cascades, ..."},
+    {OPT_SET, NULL},
+    {OPT_LIGHT, NULL},
+    {OPT_FRUSTUM, "also Lloyd's measure over the view frustum at N x N image points x N depths\n"
+                  "(perspective aliasing only; default 24, 0: off)"},
+    {OPT_THREADS, NULL},
+    {OPT_OUT, NULL},
+    {OPT_NO_PNG, "skip the PNGs"},
+    {OPT_END, NULL}};
+
+static const CliCommand aliasing_cmd = {
+    "aliasing", "SCENE [options]", true, aliasing_options,
     "writes DIR/aliasing.{exr,png,json}, aliasing-cascade.png, aliasing-hist.csv, aliasing-depth.csv,\n"
     "aliasing-axis.csv: m = pixels per texel step along the map's axes (> 1: undersampled), its histogram,\n"
     "its profile along view depth, the projection factor cos(alpha)/cos(beta), the storage factor (Lloyd et\n"
-    "al. 2006), and along the view axis the catalogue's normalised e_x, e_y (course Fig. 3.7)\n";
-
-/* Take `--frustum N` out of argv (cli_parse knows the shared options only). */
-static bool take_frustum(int *argc, char **argv, int *n, Error *err)
-{
-    for (int i = 1; i < *argc; i++) {
-        if (strcmp(argv[i], "--frustum") != 0) continue;
-        char *end = NULL;
-        long v = i + 1 < *argc ? strtol(argv[i + 1], &end, 10) : -1;
-        if (!end || *end || v < 0 || v > 256) return error_set(err, "--frustum expects an integer in [0, 256]");
-        *n = (int)v;
-        memmove(argv + i, argv + i + 2, sizeof *argv * (size_t)(*argc - i - 2));
-        *argc -= 2;
-        i--;
-    }
-    return true;
-}
+    "al. 2006), and along the view axis the catalogue's normalised e_x, e_y (course Fig. 3.7)\n"};
 
 /* "name=value" of the map parameters that differ from the defaults. */
 static void params_text(const Technique *t, const double *p, char *out, size_t n)
@@ -62,7 +50,6 @@ typedef struct AliasingJob {
     CliOptions o;
     const Technique *tech;
     double params[TECH_MAX_PARAMS];
-    int frustum;
 } AliasingJob;
 
 static bool setup(AliasingJob *j, Error *err)
@@ -92,7 +79,11 @@ static bool analyse(AliasingJob *j, Lab *lab, Error *err)
     const AliasingMap *an = map ? res_aliasing(rm, sc, light, map, err) : NULL;
     if (!an) return false;
     AliasingSummary fr;
-    if (j->frustum > 0) aliasing_frustum(&map->view, sc, &sc->lights[light], j->frustum, j->frustum, j->frustum, &fr);
+    Progress stage;
+    int n = j->o.frustum;
+    progress_begin(&stage, "frustum", 0);
+    if (n > 0) aliasing_frustum(&map->view, sc, &sc->lights[light], n, n, n, &fr);
+    progress_end(&stage);
     AliasingPoint axis[AXIS_POINTS];
     AliasingView av = aliasing_view(&sc->camera);
     for (int i = 0; i < AXIS_POINTS; i++) {
@@ -103,11 +94,15 @@ static bool analyse(AliasingJob *j, Lab *lab, Error *err)
     }
     char text[1024], dir[1024];
     params_text(j->tech, j->params, text, sizeof text);
-    AliasingReport rep = {sc, j->tech->name, text, map, an, j->frustum > 0 ? &fr : NULL, axis, AXIS_POINTS,
+    AliasingReport rep = {sc, j->tech->name, text, map, an, j->o.frustum > 0 ? &fr : NULL, axis, AXIS_POINTS,
                           timer_now_s() - t0};
     if (j->o.out_dir) snprintf(dir, sizeof dir, "%s", j->o.out_dir);
     else snprintf(dir, sizeof dir, "reports/%s", sc->name);
-    if (!aliasing_report_write(&rep, dir, "aliasing", !j->o.no_png, err)) return false;
+    progress_begin(&stage, "outputs", 0);
+    bool written = aliasing_report_write(&rep, dir, "aliasing", !j->o.no_png, err);
+    progress_end(&stage);
+    if (!written) return false;
+    progress_clear();
     aliasing_report_print(&rep, stdout);
     printf("outputs: %s/aliasing{.exr,.json,.png,-cascade.png,-hist.csv,-depth.csv,-axis.csv}\n", dir);
     return true;
@@ -117,20 +112,24 @@ int cmd_aliasing(int argc, char **argv)
 {
     AliasingJob j;
     memset(&j, 0, sizeof j);
-    j.frustum = 24;
     Error err;
-    if (!take_frustum(&argc, argv, &j.frustum, &err) || !cli_parse(argc, argv, true, &j.o, &err) ||
-        (!j.o.help && !setup(&j, &err))) {
+    if (!cli_parse(&aliasing_cmd, argc, argv, &j.o, &err) || (!j.o.help && !setup(&j, &err))) {
         fprintf(stderr, "shadowlab aliasing: %s\n", err.msg);
         return EXIT_USAGE;
     }
     if (j.o.help) {
-        fputs(help_text, stdout);
+        cli_print_help(&aliasing_cmd, stdout);
         return EXIT_OK;
     }
     cli_apply_threads(&j.o);
+    progress_set_heartbeat(true); /* this process never forks */
+    char label[PROGRESS_LABEL_MAX];
+    snprintf(label, sizeof label, "aliasing %s", j.tech->name);
+    Progress prog; /* "aliasing pcf > shadow_map, 1.2 s" on a terminal, after a second */
+    progress_begin(&prog, label, 0);
     Lab *lab = lab_open(j.o.scene, j.o.overrides, j.o.num_overrides, &err);
     bool ok = lab && analyse(&j, lab, &err);
+    progress_end(&prog);
     if (!ok) fprintf(stderr, "shadowlab aliasing: %s\n", err.msg);
     lab_close(lab);
     return ok ? EXIT_OK : EXIT_RUNTIME;

@@ -4,28 +4,33 @@
 #include <omp.h>
 #include <string.h>
 #include "cli/cli.h"
+#include "core/progress.h"
 #include "lab/compare.h"
 #include "resources/refcache.h"
 
 enum Stage { STAGE_RENDER = 1, STAGE_REFERENCE = 2 };
 
-static const char *const help_text =
-    "usage: shadowlab %s SCENE [options]\n"
-    "  -t, --technique NAME   technique (see shadowlab list)%s\n"
-    "  -p, --param K=V        technique parameter (repeatable)\n"
-    "  -s, --set KEY=V        scene override, e.g. -s lights[1].radius=0.3 (repeatable)\n"
-    "  -l, --light N          light number in the scene (default 1)\n"
-    "  -n, --samples N        reference light samples per view sample (default 1024)\n"
-    "  --pattern P            r2 | stratified | random (default r2)\n"
-    "  --seed S               sampling seed (default 1)\n"
-    "  --measure M            visibility | irradiance (reference only; default visibility)\n"
-    "  --cache DIR            reference cache folder (default $SHADOWLAB_CACHE or ~/.cache/shadowlab)\n"
-    "  --no-cache             neither read nor write the reference cache\n"
-    "  --repeat N             time N evaluations; median and minimum reported\n"
-    "  --warmup N             untimed evaluations before the timed ones (default 0)\n"
-    "  --threads N            worker threads (default: all cores)\n"
-    "  -o, --out DIR          output folder (default reports/SCENE-NAME)\n"
-    "  --no-png               skip the PNG previews\n";
+/* The options that act on each command (args.c has their help lines). */
+static const CliAccept render_options[] = {
+    {OPT_TECHNIQUE, "technique (required; see shadowlab list)"}, {OPT_PARAM, NULL}, {OPT_SET, NULL},
+    {OPT_LIGHT, NULL}, {OPT_REPEAT, NULL}, {OPT_WARMUP, NULL}, {OPT_THREADS, NULL}, {OPT_OUT, NULL},
+    {OPT_NO_PNG, NULL}, {OPT_END, NULL}};
+static const CliAccept reference_options[] = {
+    {OPT_SET, NULL}, {OPT_LIGHT, NULL}, {OPT_SAMPLES, NULL}, {OPT_PATTERN, NULL}, {OPT_SEED, NULL},
+    {OPT_MEASURE, NULL}, {OPT_CACHE, NULL}, {OPT_NO_CACHE, NULL}, {OPT_THREADS, NULL}, {OPT_OUT, NULL},
+    {OPT_NO_PNG, NULL}, {OPT_END, NULL}};
+static const CliAccept compare_options[] = {
+    {OPT_TECHNIQUE, "technique (required; see shadowlab list)"}, {OPT_PARAM, NULL}, {OPT_SET, NULL},
+    {OPT_LIGHT, NULL}, {OPT_SAMPLES, NULL}, {OPT_PATTERN, NULL}, {OPT_SEED, NULL}, {OPT_CACHE, NULL},
+    {OPT_NO_CACHE, NULL}, {OPT_REPEAT, NULL}, {OPT_WARMUP, NULL}, {OPT_THREADS, NULL}, {OPT_OUT, NULL},
+    {OPT_NO_PNG, NULL}, {OPT_END, NULL}};
+
+static const CliCommand render_cmd = {"render", "SCENE -t TECH [options]", true, render_options,
+                                      "the technique's visibility, no reference: TECH.{exr,json,png} in the output folder\n"};
+static const CliCommand reference_cmd = {"reference", "SCENE [options]", true, reference_options,
+                                         "the Embree ground truth (read from the cache when there): reference.{exr,json,png}\n"};
+static const CliCommand compare_cmd = {"compare", "SCENE -t TECH [options]", true, compare_options,
+                                       "render, reference, metrics per region and the signed error: TECH.{exr,json,png}\n"};
 
 typedef struct Job {
     CliOptions o;
@@ -42,16 +47,14 @@ static bool setup(Job *j, int stages, Error *err)
     const CliOptions *o = &j->o;
     j->req = (CompareRequest){NULL, j->params, 0, o->repeat, o->warmup, (stages & STAGE_REFERENCE) != 0, o->ref,
                               NULL, 0.0};
-    if (!(stages & STAGE_RENDER)) return reference_params_check(&o->ref, err);
+    if ((stages & STAGE_REFERENCE) && !reference_params_check(&o->ref, err)) return false;
+    if (!(stages & STAGE_RENDER)) return true;
     if (!o->technique) return error_set(err, "missing -t TECHNIQUE (see shadowlab list)");
     j->req.tech = tech_find(o->technique, err);
     if (!j->req.tech) return false;
     tech_params_default(j->req.tech, j->params);
     for (int i = 0; i < o->num_params; i++)
         if (!tech_param_parse(j->req.tech, o->params[i], j->params, err)) return false;
-    if ((stages & STAGE_REFERENCE) && !reference_params_check(&o->ref, err)) return false;
-    if (o->ref.measure != MEASURE_VISIBILITY)
-        return error_set(err, "--measure irradiance is for `shadowlab reference`; techniques estimate visibility");
     return true;
 }
 
@@ -68,34 +71,53 @@ static bool load(Job *j, Error *err)
     return lab_light_index(j->lab, j->o.light, &j->req.light_index, err);
 }
 
-static int run(const char *name, int stages, int argc, char **argv)
+/* The stages, then the outputs. */
+static bool work(Job *j, const char *name, RunReport *rep, Error *err)
 {
+    if (!lab_compare(j->lab, &j->req, &j->result, err)) return false;
+    *rep = compare_report(j->lab, &j->result, name, omp_get_max_threads());
+    Progress outputs;
+    progress_begin(&outputs, "outputs", 0);
+    bool ok = report_write_all(rep, j->out_dir, !j->o.no_png, err);
+    progress_end(&outputs);
+    return ok;
+}
+
+static int run(const CliCommand *cmd, int stages, int argc, char **argv)
+{
+    const char *name = cmd->name;
     Job j;
     memset(&j, 0, sizeof j);
     Error err;
-    if (!cli_parse(argc, argv, true, &j.o, &err) || (!j.o.help && !setup(&j, stages, &err))) {
+    if (!cli_parse(cmd, argc, argv, &j.o, &err) || (!j.o.help && !setup(&j, stages, &err))) {
         fprintf(stderr, "shadowlab %s: %s\n", name, err.msg);
         return EXIT_USAGE;
     }
     if (j.o.help) {
-        printf(help_text, name, stages & STAGE_RENDER ? " (required)" : " (unused)");
+        cli_print_help(cmd, stdout);
         return EXIT_OK;
     }
     cli_apply_threads(&j.o);
+    progress_set_heartbeat(true); /* this process never forks */
+    char label[PROGRESS_LABEL_MAX];
+    snprintf(label, sizeof label, "%s%s%s", name, j.req.tech ? " " : "", j.req.tech ? j.req.tech->name : "");
+    Progress prog; /* "compare pcf > shadow_map, 1.2 s" on a terminal, after a second */
+    progress_begin(&prog, label, 0);
     int status = EXIT_RUNTIME;
     bool loaded = load(&j, &err);
     if (loaded) { /* the first line before the work: what runs, on what */
+        progress_clear();
         report_print_header(j.lab, j.req.tech, j.req.light_index, stdout);
         fflush(stdout);
     }
-    if (loaded && lab_compare(j.lab, &j.req, &j.result, &err)) {
+    RunReport rep;
+    bool done = loaded && work(&j, name, &rep, &err);
+    progress_end(&prog);
+    if (done) {
         if (j.result.ref_info.cache_note[0]) fprintf(stderr, "shadowlab: warning: %s\n", j.result.ref_info.cache_note);
-        RunReport rep = compare_report(j.lab, &j.result, name, omp_get_max_threads());
-        if (report_write_all(&rep, j.out_dir, !j.o.no_png, &err)) {
-            report_print_body(&rep, stdout);
-            printf("outputs: %s/%s.{exr,json%s}\n", j.out_dir, report_stem(&rep), j.o.no_png ? "" : ",png");
-            status = EXIT_OK;
-        }
+        report_print_body(&rep, stdout);
+        printf("outputs: %s/%s.{exr,json%s}\n", j.out_dir, report_stem(&rep), j.o.no_png ? "" : ",png");
+        status = EXIT_OK;
     }
     if (status != EXIT_OK) fprintf(stderr, "shadowlab %s: %s\n", name, err.msg);
     compare_result_free(&j.result);
@@ -103,6 +125,6 @@ static int run(const char *name, int stages, int argc, char **argv)
     return status;
 }
 
-int cmd_render(int argc, char **argv) { return run("render", STAGE_RENDER, argc, argv); }
-int cmd_reference(int argc, char **argv) { return run("reference", STAGE_REFERENCE, argc, argv); }
-int cmd_compare(int argc, char **argv) { return run("compare", STAGE_RENDER | STAGE_REFERENCE, argc, argv); }
+int cmd_render(int argc, char **argv) { return run(&render_cmd, STAGE_RENDER, argc, argv); }
+int cmd_reference(int argc, char **argv) { return run(&reference_cmd, STAGE_REFERENCE, argc, argv); }
+int cmd_compare(int argc, char **argv) { return run(&compare_cmd, STAGE_RENDER | STAGE_REFERENCE, argc, argv); }

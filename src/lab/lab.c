@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/progress.h"
 #include "core/timer.h"
 
 struct Lab {
@@ -104,8 +105,11 @@ static bool run_evaluations(const RenderRequest *req, const RenderTiming *timing
     if (!times) return false;
     int n = 0;
     double total = 0;
+    Progress prog; /* the progress line's "evaluate 3/10" (core/progress.h) */
+    progress_begin(&prog, "evaluate", timing->warmup + req->repeat);
     for (out->warmup = 0; out->warmup < timing->warmup; out->warmup++) {
         double t = evaluate_all(req->tech, state, ctx, &out->visibility);
+        progress_add(&prog, 1);
         if (timing->budget_s > 0 && t >= timing->budget_s) {
             times[n++] = total = t; /* long enough that caches cannot matter: it is the timed one */
             break;
@@ -114,7 +118,9 @@ static bool run_evaluations(const RenderRequest *req, const RenderTiming *timing
     while (n < req->repeat && (n == 0 || timing->budget_s <= 0 || total < timing->budget_s)) {
         times[n] = evaluate_all(req->tech, state, ctx, &out->visibility);
         total += times[n++];
+        progress_add(&prog, 1);
     }
+    progress_end(&prog);
     qsort(times, (size_t)n, sizeof(double), cmp_double);
     out->repeat = n;
     out->eval_min_s = times[0];
@@ -173,9 +179,12 @@ bool lab_render_timed(Lab *lab, const RenderRequest *req, const RenderTiming *ti
     }
     void *state = NULL;
     rm_scope_begin(lab->rm);
+    Progress prog;
+    progress_begin(&prog, "prepare", 0);
     t0 = timer_now_s();
     bool prepared = req->tech->prepare(&ctx, &state, err);
     out->prepare_s = timer_now_s() - t0;
+    progress_end(&prog);
     rm_scope_end(lab->rm);
     if (!prepared) {
         render_result_free(out);

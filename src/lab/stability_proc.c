@@ -18,6 +18,7 @@
 #include <sys/prctl.h>
 #endif
 #include "core/fsutil.h"
+#include "core/progress.h"
 #include "core/timer.h"
 
 #define MAX_AT_ONCE 64
@@ -193,6 +194,7 @@ int stab_proc_next(StabProc *const *ps, int n, StabEvent *ev)
         }
         struct pollfd pf[MAX_AT_ONCE];
         for (int i = 0; i < n; i++) pf[i] = (struct pollfd){ps[i]->fd, POLLIN, 0};
+        progress_tick(); /* the caller's progress line shows the time passing (at most each wait_s <= 1 s) */
         if (poll(pf, (nfds_t)n, (int)ceil(wait_s * 1000.0)) <= 0) continue; /* timeout or EINTR */
         for (int i = 0; i < n; i++)
             if (pf[i].revents && take(ps[i], ev)) return i;

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/progress.h"
 #include "core/timer.h"
 
 #define RM_MAX_DEPTH 16
@@ -129,9 +130,12 @@ static int build_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t k
     BuildFrame *f = &rm->frames[rm->depth++];
     f->deps.n = 0;
     f->nested_s = 0;
+    Progress prog; /* "... > shadow_map, 2.1 s" on a terminal (core/progress.h) */
+    progress_begin(&prog, kind->name, 0);
     double t0 = timer_now_s();
     void *res = build(args, err);
     double dt = timer_now_s() - t0;
+    progress_end(&prog);
     rm->depth--;
     if (!res) return -1;
     if (rm->count == rm->cap) {

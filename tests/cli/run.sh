@@ -61,7 +61,8 @@ expect usage_unknown_param 2 "unknown parameter 'K'" -- "$SL" render "$SCENE" -t
 expect usage_samples_range 2 "\[1, 1048576\]" -- "$SL" reference "$SCENE" -n 0
 expect usage_stratified_needs_square 2 "square" -- "$SL" reference "$SCENE" -n 10 --pattern stratified
 expect runtime_light_out_of_range 1 "--light 3 outside \[1, 1\]" -- "$SL" render "$SCENE" -t hard -l 3 -o "$TMP/l3"
-expect help_compare 0 "--samples" "--measure" -- "$SL" compare --help
+expect help_compare 0 "--samples" "--repeat" -- "$SL" compare --help
+expect help_reference 0 "--samples" "--measure" -- "$SL" reference --help
 expect list_shows_hard 0 "hard" "offset_scale" "course" -- "$SL" list
 
 "$SL" list --json >"$TMP/list.json" 2>"$TMP/err"
@@ -69,9 +70,64 @@ if command -v python3 >/dev/null && python3 -c 'import json,sys; d=json.load(ope
     ok list_json_parses
 elif ! command -v python3 >/dev/null; then ok list_json_parses_skipped_no_python; else no list_json_parses "invalid JSON"; fi
 
-"$SL" list --markdown >"$TMP/techniques.md" 2>"$TMP/err"
-if cmp -s "$TMP/techniques.md" "$ROOT/docs/techniques.md"; then ok docs_techniques_generated_from_registry
-else no docs_techniques_generated_from_registry "docs/techniques.md is stale: run make docs"; fi
+# Each command takes exactly the options that act on it, and its --help lists
+# exactly those: every option any --help lists is parsed by the commands that
+# list it (with a valid value, then --help) and refused, naming it and the
+# command, by every other.
+value_for() {
+    case $1 in
+        NAME) echo hard ;; K=V | KEY=V) echo a=1 ;; DIR) echo "$TMP/unused" ;; P) echo r2 ;;
+        M) echo visibility ;; TEXT) echo x ;; *) echo 2 ;;
+    esac
+}
+CMDS="list render reference compare aliasing stability"
+for cmd in $CMDS; do
+    "$SL" "$cmd" --help | sed -n 's/^  \(-[a-z], \)\{0,1\}\(--[a-z-]*\)\( [A-Z=][A-Z=]*\)\{0,1\}  .*/\2\3/p' | grep -v '^--help$' >"$TMP/opts-$cmd"
+done
+sort -u "$TMP"/opts-* >"$TMP/opts-all"
+for cmd in $CMDS; do
+    case $cmd in render | reference | compare | aliasing) scene=$SCENE ;; *) scene= ;; esac
+    bad=""
+    while read -r opt meta; do
+        val=""; [ -n "$meta" ] && val=$(value_for "$meta")
+        # shellcheck disable=SC2086 -- $scene and $val are one word or none
+        "$SL" "$cmd" $scene "$opt" $val --help >"$TMP/out" 2>"$TMP/err"; got=$?
+        if grep -qx -- "$opt${meta:+ $meta}" "$TMP/opts-$cmd"; then
+            [ "$got" -eq 0 ] || bad="$bad $opt(accepted in --help, exit $got)"
+        elif [ "$got" -ne 2 ] || ! grep -q -- "'$opt' does not apply to \`shadowlab $cmd\`" "$TMP/err"; then
+            bad="$bad $opt(not in --help, exit $got)"
+        fi
+    done <"$TMP/opts-all"
+    if [ -z "$bad" ]; then ok "options_of_${cmd}_are_exactly_its_help"; else no "options_of_${cmd}_are_exactly_its_help" "$bad"; fi
+done
+# the audit's cases (issue 2), by name
+expect list_refuses_threads 2 "'--threads' does not apply to \`shadowlab list\`" -- "$SL" list --threads 3
+expect list_refuses_technique 2 "'-t' does not apply" -- "$SL" list -t hard
+expect list_formats_exclusive 2 "exclusive" -- "$SL" list --json --names
+for opt in "-t hard" "-p K=3" "--repeat 5" "--warmup 1"; do
+    expect "reference_refuses_${opt%% *}" 2 "'${opt%% *}' does not apply to \`shadowlab reference\`" -- "$SL" reference "$SCENE" $opt
+done
+for opt in "-n 64" "--pattern random" "--seed 3" "--cache $TMP/c" "--no-cache" "--measure irradiance"; do
+    expect "render_refuses_${opt%% *}" 2 "'${opt%% *}' does not apply to \`shadowlab render\`" -- "$SL" render "$SCENE" -t hard $opt
+done
+expect compare_refuses_measure 2 "'--measure' does not apply to \`shadowlab compare\`" -- "$SL" compare "$SCENE" -t hard --measure irradiance
+expect aliasing_refuses_repeat 2 "'--repeat' does not apply to \`shadowlab aliasing\`" -- "$SL" aliasing "$SCENE" --repeat 2
+expect stability_list_takes_no_other 2 "--list takes no other option" -- "$SL" stability --list --quick
+expect stability_refuses_json 2 "'--json' does not apply" -- "$SL" stability --json
+
+# docs/techniques.md and the README's block are generated from the registry
+# (make docs); the check notices a hand edit of the README's table and a lost marker.
+if "$ROOT/scripts/docs.sh" --check "$SL" >"$TMP/out" 2>"$TMP/err"; then ok docs_generated_from_registry
+else no docs_generated_from_registry "$(cat "$TMP/err")"; fi
+mkdir -p "$TMP/docs-root/docs"
+cp "$ROOT/docs/techniques.md" "$TMP/docs-root/docs/"
+sed 's/^| `hard` | ray traced |/| `hard` | hand-edited |/' "$ROOT/README.md" >"$TMP/docs-root/README.md"
+expect docs_check_notices_a_hand_edited_readme 1 "README.md is out of date" -- "$ROOT/scripts/docs.sh" --check "$SL" "$TMP/docs-root"
+expect docs_regenerates_the_readme 0 "wrote" -- "$ROOT/scripts/docs.sh" "$SL" "$TMP/docs-root"
+if cmp -s "$TMP/docs-root/README.md" "$ROOT/README.md"; then ok docs_regenerated_readme_is_the_committed_one
+else no docs_regenerated_readme_is_the_committed_one "differs"; fi
+grep -v '^<!-- END generated -->$' "$ROOT/README.md" >"$TMP/docs-root/README.md"
+expect docs_check_needs_the_markers 1 "marker" -- "$ROOT/scripts/docs.sh" --check "$SL" "$TMP/docs-root"
 
 # compare writes every output and its record; a second run reads the cache.
 OUT=$TMP/cmp
@@ -99,6 +155,78 @@ done
 expect aliasing_refuses_a_mapless_technique 2 "hard renders no shadow map" -- "$SL" aliasing "$PLANE" -t hard -o "$TMP/al-hard"
 expect aliasing_refuses_bad_frustum 2 "--frustum expects" -- "$SL" aliasing "$PLANE" --frustum -3 -o "$TMP/al-bad"
 expect aliasing_param_range 2 "cascades" "\[1, 16\]" -- "$SL" aliasing "$PLANE" -p cascades=17 -o "$TMP/al-bad"
+
+# The progress line (issue 2): on stderr, only when it is a terminal, only
+# for work longer than a second, erased when the work ends. A terminal is a
+# pty from util-linux's script(1). A run is conclusive only when its wall time
+# says so (longer than 2 s, or shorter than 0.8 s): the repeats grow until
+# one is long enough; nothing here asserts a speed.
+now() { date +%s.%N; }
+longer() { awk -v a="$1" -v b="$2" -v s="$3" 'BEGIN { exit !(b - a > s) }'; }
+LONG="$SL render $SCENE -t hard --no-png -o $TMP/progress"
+if command -v script >/dev/null && script -qec true /dev/null >/dev/null 2>&1; then
+    n=50; conclusive=0
+    while [ "$n" -le 3200 ]; do
+        t0=$(now); script -qec "$LONG --repeat $n" /dev/null >"$TMP/pty" 2>&1; t1=$(now)
+        if longer "$t0" "$t1" 2; then conclusive=1; break; fi
+        n=$((n * 4))
+    done
+    tr '\r' '\n' <"$TMP/pty" >"$TMP/pty-lines"
+    if [ "$conclusive" -eq 0 ]; then ok progress_on_a_terminal_skipped_runs_too_fast
+    elif grep -q "^render hard > evaluate [0-9]*/$n, [0-9.]* s" "$TMP/pty-lines"; then ok progress_line_on_a_terminal_after_a_second
+    else no progress_line_on_a_terminal_after_a_second "no 'render hard > evaluate k/$n' in: $(head -3 "$TMP/pty-lines")"; fi
+    # erased before the table: blanks over the last progress text, then the table
+    if [ "$conclusive" -eq 1 ]; then
+        if grep -A1 '^ *$' "$TMP/pty-lines" | grep -q '^technique: prepare'; then ok progress_line_erased_before_the_table
+        else no progress_line_erased_before_the_table "the table does not follow an erased line"; fi
+    fi
+    t0=$(now); script -qec "$SL render $SCENE -t hard --no-png $SMALL -o $TMP/progress" /dev/null >"$TMP/pty" 2>&1; t1=$(now)
+    if longer "$t0" "$t1" 0.8; then ok progress_none_for_short_work_skipped_machine_slow
+    elif grep -q "render hard >" "$TMP/pty"; then no progress_none_for_short_work "drawn for a run under a second"
+    else ok progress_none_for_short_work; fi
+else
+    ok progress_on_a_terminal_skipped_no_script
+    n=400
+fi
+$LONG --repeat "$n" >"$TMP/out" 2>"$TMP/err"
+if [ -s "$TMP/err" ]; then no progress_none_when_stderr_is_not_a_terminal "stderr: $(tr '\r' '\n' <"$TMP/err" | head -2)"
+else ok progress_none_when_stderr_is_not_a_terminal; fi
+
+# make demo's script: every technique on a scene with a light it handles
+# (the default scene, else contact.lua for adaptive_area), a metrics row and
+# a record for each, and a run that fails fails the demo, naming it. A
+# wrapper shrinks every run (32 x 24 views, 16 reference samples, maps of
+# 128^2, no PNGs) and fails the one run named by DEMO_FAIL.
+"$SL" list >"$TMP/list.txt"
+cat >"$TMP/small-sl" <<WRAPPER
+#!/bin/sh
+cmd=\$1; shift
+case \$cmd in
+    reference|compare)
+        [ "\${DEMO_FAIL:-}" = "\$*" ] && exit 1
+        map=""
+        [ "\$cmd" = compare ] && awk -v t="\$3" '/^[^ ]/ { here = (\$1 == t) } here && /^  -p map_size=/ { f = 1 } END { exit !f }' "$TMP/list.txt" && map="-p map_size=128"
+        exec "$SL" "\$cmd" "\$@" -s camera.width=32 -s camera.height=24 -n 16 --no-png \$map ;;
+    *) exec "$SL" "\$cmd" "\$@" ;;
+esac
+WRAPPER
+chmod +x "$TMP/small-sl"
+DEMO=$TMP/demo
+if (cd "$ROOT" && ./scripts/demo.sh "$TMP/small-sl" "$DEMO") >"$TMP/out" 2>"$TMP/err"; then ok demo_runs_every_technique
+else no demo_runs_every_technique "$(tail -2 "$TMP/err")"; fi
+missing=""
+for tech in $("$SL" list --names); do
+    grep -q "^| \`$tech\` |" "$DEMO/metrics.md" 2>/dev/null || missing="$missing $tech(row)"
+    ls "$DEMO"/*/"$tech.json" >/dev/null 2>&1 || missing="$missing $tech(record)"
+done
+if [ -z "$missing" ]; then ok demo_metrics_row_and_record_per_technique; else no demo_metrics_row_and_record_per_technique "$missing"; fi
+if grep -q '^| `adaptive_area` | contact | rect |' "$DEMO/metrics.md" 2>/dev/null; then ok demo_gives_adaptive_area_a_rect_light
+else no demo_gives_adaptive_area_a_rect_light "$(grep adaptive_area "$DEMO/metrics.md" 2>&1)"; fi
+expect demo_fails_loudly_naming_the_run 1 "FAILED: hard" -- \
+    env DEMO_FAIL="scenes/sphere-on-plane.lua -t hard --repeat 5 -o $TMP/demo-fail/sphere-on-plane" \
+    sh -c "cd '$ROOT' && exec ./scripts/demo.sh '$TMP/small-sl' '$TMP/demo-fail'"
+if [ -e "$TMP/demo-fail/metrics.md" ]; then no demo_failure_writes_no_metrics_table "metrics.md written"
+else ok demo_failure_writes_no_metrics_table; fi
 
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -13,7 +13,8 @@ export SHADOWLAB_PLUGIN_DIR=$(dirname "$SL")
 VG="valgrind -q --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite --show-leak-kinds=definite"
 VG="$VG --suppressions=$ROOT/tests/valgrind/valgrind.supp"
 SCENE=$ROOT/scenes/sphere-on-plane.lua
-SMALL="-n 4 -s camera.width=24 -s camera.height=18 --threads 2"
+VIEW="-s camera.width=24 -s camera.height=18 --threads 2"
+SMALL="-n 4 $VIEW" # render takes no reference option
 pass=0
 fail=0
 
@@ -33,7 +34,7 @@ vg() {
 vg list 0 "$SL" list
 vg compare_hard 0 "$SL" compare "$SCENE" -t hard $SMALL --no-png -o "$TMP/a"
 vg compare_hard_cache_hit 0 "$SL" compare "$SCENE" -t hard $SMALL --no-png -o "$TMP/a"
-vg render_sm_rasterizer 0 "$SL" render "$SCENE" -t sm -p map_size=256 $SMALL --no-png -o "$TMP/b"
+vg render_sm_rasterizer 0 "$SL" render "$SCENE" -t sm -p map_size=256 $VIEW --no-png -o "$TMP/b"
 vg compare_pcf_with_png 0 "$SL" compare "$SCENE" -t pcf -p map_size=256 $SMALL -o "$TMP/c"
 vg bad_scene_refused 1 "$SL" compare "$ROOT/tests/scenes/bad/nan-vertex.lua" -t hard -n 4 -o "$TMP/d"
 vg stability_forked_runs 0 "$SL" stability -t hard --quick --case contact --threads 2
