@@ -78,6 +78,7 @@ expect run_help_lists_every_experiment_option 0 --out --resume --fresh --shard -
     --samples --set --no-images --quiet -- "$SL" run --help
 expect experiment_unknown_argument 2 "unknown argument '--frob'" -- "$SL" run "$SWEEP" --frob
 expect experiment_bad_shard 2 "--shard expects I/N" -- "$SL" run "$SWEEP" --shard 2/2
+expect nonfinite_params_refused_from_lua 0 "refusals checked" -- "$SL" run tests/lua/nonfinite-params.lua
 
 # ---- the unsharded sweep (with images: the browser test opens its report)
 FULL=$TMP/full
