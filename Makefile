@@ -84,6 +84,10 @@ $(B)/test_unit_san: $(TEST_SAN) $(SAN_OBJ)
 	$(CC) $(SAN) -o $@ $^ $(LIBS)
 $(B)/test_stability_san: $(STAB_SAN) $(SAN_OBJ)
 	$(CC) $(SAN) -o $@ $^ $(LIBS)
+# The CLI on the sanitized objects: tests/run.sh runs the CLI tests and the
+# quick stability matrix with it (it finds the plugin next to itself).
+$(B)/shadowlab_san: $(B)/san/src/cli/main.o $(SAN_OBJ)
+	$(CC) $(SAN) -o $@ $^ $(LIBS)
 
 $(B)/fuzz/%.o: %.c $(DEPS)
 	@mkdir -p $(dir $@)
@@ -92,12 +96,15 @@ $(B)/fuzz/%.o: %.c $(DEPS)
 $(B)/fuzz_%: $(B)/fuzz/tests/fuzz/fuzz_%.o $(FUZZ_OBJ)
 	$(FUZZ_CC) $(FUZZ_SAN) -fsanitize=fuzzer -o $@ $^ $(LIBS)
 fuzzers: $(FUZZERS)
+# Kept between builds (as intermediates of the pattern rules they would be
+# deleted, and every fuzzer relink would recompile the whole library).
+.SECONDARY: $(FUZZ_OBJ) $(FUZZERS:$(B)/fuzz_%=$(B)/fuzz/tests/fuzz/fuzz_%.o)
 # The long fuzz run (README): every harness for FUZZ_SECONDS, new inputs kept in build/fuzz-corpus.
 fuzz: $(FUZZERS) $(PLUGIN)
 	./tests/fuzz/run.sh $(B) $(FUZZ_SECONDS) 1
 
-# Unit tests once under ASan+UBSan, then the CLI tests on the optimised build.
-test: all $(B)/test_unit_san $(B)/test_stability_san $(FUZZERS)
+# The whole suite (tests/run.sh): unit, CLI and stability tests under ASan+UBSan, Lua tests on the optimised build.
+test: all $(B)/test_unit_san $(B)/test_stability_san $(B)/shadowlab_san $(FUZZERS)
 	@B=$(B) ./tests/run.sh
 test-unit: all $(B)/test_unit
 	SHADOWLAB_MODEL_PATH=$${SHADOWLAB_MODEL_PATH:-../shared/models} SHADOWLAB_PLUGIN_DIR=$(CURDIR)/$(B) ./$(B)/test_unit $(T)
@@ -115,4 +122,4 @@ bench: all
 clean:
 	rm -rf $(B)
 
--include $(LIB_OBJ:.o=.d) $(SAN_OBJ:.o=.d) $(TEST_OBJ:.o=.d) $(TEST_SAN:.o=.d) $(STAB_SAN:.o=.d) $(FUZZ_OBJ:.o=.d)
+-include $(B)/san/src/cli/main.d $(LIB_OBJ:.o=.d) $(SAN_OBJ:.o=.d) $(TEST_OBJ:.o=.d) $(TEST_SAN:.o=.d) $(STAB_SAN:.o=.d) $(FUZZ_OBJ:.o=.d)

@@ -15,7 +15,8 @@ static const CliAccept stability_options[] = {
     {OPT_TECHNIQUE, "only this technique (engine input cases are then skipped)"},
     {OPT_OUT, "write DIR/stability.{json,csv,md} and DIR/scenes/<case>-<light>/scene.lua\n"
               "(parameter rows: DIR/scenes/params-<light>/scene.lua)"},
-    {OPT_CASE, NULL},
+    {OPT_CASE, "only cases whose name contains TEXT; TEXT,TEXT: any of them; !TEXT: not those\n"
+               "(--case '!image_4096': every case but that one)"},
     {OPT_QUICK, "make test's matrix: 40 x 30 views, 16 reference samples (none for heavy\n"
                 "cases), map sizes capped at 128 texels except in their own probes, one row\n"
                 "per parameter for all its probes; every case runs"},

@@ -103,9 +103,24 @@ typedef struct Runner {
     bool oom;
 } Runner;
 
+/* Does the comma-separated filter (stability.h) take case_name? */
 static bool wanted(const Runner *rn, const char *case_name)
 {
-    return !rn->o->only || strstr(case_name, rn->o->only);
+    const char *f = rn->o->only;
+    if (!f) return true;
+    bool any_include = false, included = false;
+    while (*f) {
+        size_t n = strcspn(f, ",");
+        bool exclude = f[0] == '!';
+        char term[STAB_NAME_MAX];
+        snprintf(term, sizeof term, "%.*s", (int)(n - exclude), f + exclude);
+        bool hit = strstr(case_name, term) != NULL;
+        if (exclude && hit) return false;
+        any_include = any_include || !exclude;
+        included = included || (!exclude && hit);
+        f += n + (f[n] == ',');
+    }
+    return included || !any_include;
 }
 
 static void add_job(Runner *rn, const Technique *t, const StabCase *c, int param, ParamProbe probe, LightKind kind,

@@ -18,7 +18,8 @@ typedef struct StabOptions {
     bool quick;            /* reduced sizes (STAB_QUICK_*), one row per parameter (make test); every case still runs */
     double timeout_s;      /* per run; 0: 120 s. A case's shared preparation gets 3 times this */
     int threads;           /* per run; 0: the cores divided among the concurrent runs */
-    const char *only;      /* run only cases whose name contains this; NULL: all */
+    const char *only;      /* NULL: all cases; else comma-separated terms: the cases whose name contains
+                            * any TEXT term (all if there is none), less those containing a !TEXT term */
     const char *work_dir;  /* existing scratch folder for scene files and child logs */
     const char *scene_dir; /* if set, every case's scene file is kept there (to reproduce a row) */
     int jobs;              /* runs at once; 0: 1 */

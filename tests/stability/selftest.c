@@ -145,6 +145,16 @@ static void expect_shared_preparation(void)
     report("harness_runs_share_the_case_preparation", ok, &c);
 }
 
+/* --case with a list and an exclusion: "contact,coplanar,!contact" runs
+ * coplanar_caster alone; "!a" alone keeps everything else. */
+static void expect_case_filter(void)
+{
+    Collected c = run(OK_HALF, LIGHTS_ALL, "contact,coplanar,!contact", 1);
+    bool ok = c.n > 0;
+    for (int i = 0; ok && i < c.n; i++) ok = !strcmp(c.rows[i].case_name, "coplanar_caster");
+    report("harness_case_filter_takes_a_list_and_exclusions", ok, &c);
+}
+
 static void selftests(void)
 {
     const unsigned all = LIGHTS_ALL, spot = LIGHT_BIT(LIGHT_SPOT);
@@ -174,11 +184,13 @@ static void selftests(void)
     expect("harness_checks_the_umbra_limit", ALWAYS_LIT, LIGHT_BIT(LIGHT_POINT), "light_inside_occluder", STAB_FAIL,
            "leaks out of the closed box");
     expect_shared_preparation();
+    expect_case_filter();
 }
 
 /* The engine under the sanitizers on every extreme case: `hard` (the
  * ray-traced limit, little code of its own) and the input cases. The
- * registry's whole matrix runs on the optimised build (tests/run.sh). */
+ * registry's whole matrix runs from tests/run.sh, on the optimised build and
+ * on shadowlab_san (every case but image_4096x4096). */
 static int sanitized, sanitized_failed;
 
 static void print_row(const StabResult *r, void *user)
