@@ -262,9 +262,6 @@ static const ResourceKind kind_sat = {"sat", prefiltered_bytes, prefiltered_dest
 
 typedef struct PrefilterArgs { const MomentMap *mm; PrefilterKind kind; int K; uint64_t key; } PrefilterArgs;
 
-/* Channels a box blur's intermediate holds at once (its memory: res x stride x this). */
-#define BOX_CHUNK 8
-
 /* For each of nc interleaved channels, out[o] = mean of in[clamp(o - shift
  * + k)], k = 0..K-1 (edge replicated); for log values, the log of the mean
  * of their exponentials, shifted by the window's max so no exponential
@@ -301,17 +298,21 @@ static void box_line(const double *in, int n_in, double *out, int n_out, int nc,
 #undef IN
 }
 
-/* Separable K x K box of channels [c0, c0 + nc) of one face: the moment
- * map's rows into `tmp` (res rows x stride), then its columns into the
- * padded output. false when a thread's line buffers cannot be allocated. */
-static bool box_channels(Prefiltered *pf, int f, int c0, int nc, double *tmp)
+/* Separable K x K box of every channel of one face, with no intermediate
+ * beyond the output: the moment map's rows, blurred, into the output's rows
+ * pad .. pad + res - 1, then each output column, read back from those rows
+ * and blurred, into the whole padded column (a column is one thread's, so
+ * reading and writing it in place is safe). false when a thread's line
+ * buffers cannot be allocated. */
+static bool box_face(Prefiltered *pf, int f)
 {
     const MomentMap *mm = pf->moments;
-    int res = pf->res, S = pf->stride, C = pf->channels, shift = pf->pad + pf->K / 2;
+    int res = pf->res, S = pf->stride, C = pf->channels, pad = pf->pad, shift = pf->pad + pf->K / 2;
     bool ok = true;
+#define OUT(J_, I_, c_) ((((size_t)f * S + (J_)) * S + (I_)) * C + (c_))
 #pragma omp parallel
     {
-        double *in = malloc(sizeof *in * (size_t)res * nc), *out = malloc(sizeof *out * (size_t)S * nc);
+        double *in = malloc(sizeof *in * (size_t)S * C), *out = malloc(sizeof *out * (size_t)S * C);
         if (!in || !out) {
 #pragma omp atomic write
             ok = false;
@@ -319,24 +320,23 @@ static bool box_channels(Prefiltered *pf, int f, int c0, int nc, double *tmp)
 #pragma omp for schedule(static)
         for (int j = 0; j < res; j++) {
             if (!in || !out) continue;
-            for (int i = 0; i < res; i++)
-                for (int c = 0; c < nc; c++)
-                    in[(size_t)i * nc + c] = pf_get(&mm->data, (((size_t)f * res + j) * res + i) * C + c0 + c);
-            box_line(in, res, tmp + (size_t)j * S * nc, S, nc, pf->K, shift, pf->log);
+            for (size_t k = 0; k < (size_t)res * C; k++) in[k] = pf_get(&mm->data, ((size_t)f * res + j) * res * C + k);
+            box_line(in, res, out, S, C, pf->K, shift, pf->log);
+            for (size_t k = 0; k < (size_t)S * C; k++) pf_put(&pf->data, OUT(j + pad, 0, 0) + k, out[k]);
         }
 #pragma omp for schedule(static)
         for (int I = 0; I < S; I++) {
             if (!in || !out) continue;
             for (int j = 0; j < res; j++)
-                for (int c = 0; c < nc; c++) in[(size_t)j * nc + c] = tmp[((size_t)j * S + I) * nc + c];
-            box_line(in, res, out, S, nc, pf->K, shift, pf->log);
+                for (int c = 0; c < C; c++) in[(size_t)j * C + c] = pf_get(&pf->data, OUT(j + pad, I, c));
+            box_line(in, res, out, S, C, pf->K, shift, pf->log);
             for (int J = 0; J < S; J++)
-                for (int c = 0; c < nc; c++)
-                    pf_put(&pf->data, (((size_t)f * S + J) * S + I) * C + c0 + c, out[(size_t)J * nc + c]);
+                for (int c = 0; c < C; c++) pf_put(&pf->data, OUT(J, I, c), out[(size_t)J * C + c]);
         }
         free(in);
         free(out);
     }
+#undef OUT
     return ok;
 }
 
@@ -404,11 +404,9 @@ static void *build_prefiltered(const void *args, Error *err)
      * 8 stride eps times the largest (first-order bound, Higham §4.2). */
     pf->sat_rel_error = 8.0 * pf->stride * (pf->f64 ? DBL_EPSILON : FLT_EPSILON) / 2.0;
     pf->offset = calloc((size_t)pf->num_faces * pf->channels, sizeof *pf->offset);
-    double *tmp = a->kind == PREFILTER_BOX ? malloc(sizeof *tmp * (size_t)pf->res * pf->stride * BOX_CHUNK) : NULL;
-    if (!pf->offset || (a->kind == PREFILTER_BOX && !tmp) || !store_alloc(&pf->data, prefiltered_entries(pf), pf->f64)) {
+    if (!pf->offset || !store_alloc(&pf->data, prefiltered_entries(pf), pf->f64)) {
         error_set(err, "out of memory for a %d-channel %d^2 %s", pf->channels, pf->res,
                   a->kind == PREFILTER_BOX ? "box blur" : "summed-area table");
-        free(tmp);
         prefiltered_destroy(pf);
         return NULL;
     }
@@ -419,10 +417,8 @@ static void *build_prefiltered(const void *args, Error *err)
             sat_face(pf, f);
             continue;
         }
-        for (int c0 = 0; ok && c0 < pf->channels; c0 += BOX_CHUNK)
-            ok = box_channels(pf, f, c0, pf->channels - c0 < BOX_CHUNK ? pf->channels - c0 : BOX_CHUNK, tmp);
+        ok = box_face(pf, f);
     }
-    free(tmp);
     if (!ok) {
         prefiltered_destroy(pf);
         error_set(err, "out of memory for the box blur's line buffers");
