@@ -26,7 +26,7 @@
 
 const char *stab_status_name(StabStatus s)
 {
-    static const char *const names[] = {"pass", "FAIL", "n/a"};
+    static const char *const names[] = {"pass", "FAIL", "n/a", "known"};
     return names[s];
 }
 

@@ -242,6 +242,36 @@ static void light_touching(SceneSpec *s, LightKind k, const StabSettings *st)
     set3(s->light_aim, 0.5, 0, 0.5);
 }
 
+/* Why techniques miss the closed box's umbra: each reason is its source's. */
+static const KnownLimit inside_occluder_known[] = {
+    {"accumulation", LIGHTS_ALL,
+     "seed 000 assumptions 1-2: a caster nearer the light than the plane n back-projects into the middle of the "
+     "K x K kernel, so walls around the light cover a fraction of it (they would need ~125 lexels; K <= 32)"},
+    {"shadow_width", LIGHT_BIT(LIGHT_POINT) | LIGHT_BIT(LIGHT_SPHERE), /* a spot's cone keeps widths small: it meets the limit */
+     "seed 003 §3: I = 1 + c_bias - c_scale sw / sd darkens only where the width (capped at 1 / start_difference "
+     "texels) is large against the shadow depth; receivers far behind an enclosing wall are only attenuated"},
+    {NULL, LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_TEXTURED_RECT),
+     "a one-sided area light's map is one perspective face (course §2.1): receivers in its hemisphere outside "
+     "that frustum are outside the map, taken as lit"},
+    {NULL, 0, NULL},
+};
+
+static bool acquires_shadow_map(const Technique *t)
+{
+    for (const char *const *r = t->resources; r && *r; r++)
+        if (strcmp(*r, "shadow_map") == 0) return true;
+    return false;
+}
+
+const KnownLimit *stab_known_limit(const StabCase *c, const Technique *t, LightKind kind)
+{
+    for (const KnownLimit *k = c->known; t && k && k->reason; k++) {
+        bool tech = k->technique ? strcmp(k->technique, t->name) == 0 : acquires_shadow_map(t);
+        if (tech && (k->lights & LIGHT_BIT(kind))) return k;
+    }
+    return NULL;
+}
+
 static void light_inside_occluder(SceneSpec *s, LightKind k, const StabSettings *st)
 {
     (void)k; (void)st;
@@ -622,87 +652,87 @@ static void in_triangle_budget(SceneSpec *s, LightKind k, const StabSettings *st
 
 static const StabCase cases[] = {
     {"light_size_1e-6", GROUP_LIGHT, "area light of size 1e-6: converges to the hard shadow (MAE <= 0.02, <= 2% misclassified)",
-     AREA, PLAN_EACH, false, false, true, light_tiny, limit_hard, {0}},
+     AREA, PLAN_EACH, false, false, true, light_tiny, limit_hard, {0}, NULL},
     {"light_larger_than_scene", GROUP_LIGHT, "area light of size 100 (a sphere light containing the whole scene)",
-     AREA, PLAN_EACH, false, false, false, light_huge, NULL, {0}},
+     AREA, PLAN_EACH, false, false, false, light_huge, NULL, {0}, NULL},
     {"light_touching_occluder", GROUP_LIGHT, "light centre on the box's top face (a sphere light resting on it)",
-     POSITIONED, PLAN_EACH, false, false, false, light_touching, NULL, {0}},
+     POSITIONED, PLAN_EACH, false, false, false, light_touching, NULL, {0}, NULL},
     {"light_inside_occluder", GROUP_LIGHT,
      "light inside the closed box: the ground is in umbra (mean leak <= 0.02, <= 1% of it lit)",
-     POSITIONED, PLAN_EACH, false, true, false, light_inside_occluder, limit_all_umbra, {0}},
+     POSITIONED, PLAN_EACH, false, true, false, light_inside_occluder, limit_all_umbra, {0}, inside_occluder_known},
     {"light_inside_scene_bounds", GROUP_LIGHT, "light beside the box, inside the scene's bounding box",
-     POSITIONED, PLAN_EACH, false, true, false, light_inside_bounds, NULL, {0}},
+     POSITIONED, PLAN_EACH, false, true, false, light_inside_bounds, NULL, {0}, NULL},
     {"light_below_receiver", GROUP_LIGHT, "light under the ground plane: the ground is back-facing, not shadowed",
-     LIGHTS_ALL, PLAN_EACH, false, false, false, light_below, limit_no_ground_candidates, {0}},
+     LIGHTS_ALL, PLAN_EACH, false, false, false, light_below, limit_no_ground_candidates, {0}, NULL},
     {"light_grazing_89.9deg", GROUP_LIGHT, "light at 89.9 degrees from the ground's normal",
-     LIGHTS_ALL, PLAN_EACH, false, false, false, light_grazing, NULL, {0}},
+     LIGHTS_ALL, PLAN_EACH, false, false, false, light_grazing, NULL, {0}, NULL},
     {"light_straight_down", GROUP_LIGHT, "light aimed exactly along -Y (a light 'look at' with up = +Y degenerates)",
-     AIMED, PLAN_EACH, false, false, false, light_straight_down, NULL, {0}},
+     AIMED, PLAN_EACH, false, false, false, light_straight_down, NULL, {0}, NULL},
     {"directional_along_view", GROUP_LIGHT, "directional light exactly parallel to the view direction",
-     DIRECTIONAL, PLAN_EACH, false, false, false, light_along_view, NULL, {0}},
+     DIRECTIONAL, PLAN_EACH, false, false, false, light_along_view, NULL, {0}, NULL},
     {"directional_against_view", GROUP_LIGHT, "directional light exactly opposite to the view direction",
-     DIRECTIONAL, PLAN_EACH, false, false, false, light_against_view, NULL, {0}},
+     DIRECTIONAL, PLAN_EACH, false, false, false, light_against_view, NULL, {0}, NULL},
 
     {"contact", GROUP_GEOMETRY, "box and ball resting on the ground (receiver touching the caster)",
-     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_contact, NULL, {0}},
+     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_contact, NULL, {0}, NULL},
     {"coplanar_caster", GROUP_GEOMETRY, "a disk lying in the ground's plane, casting and receiving",
-     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_coplanar, NULL, {0}},
+     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_coplanar, NULL, {0}, NULL},
     {"zero_area_triangles", GROUP_GEOMETRY, "collinear and coincident-vertex triangles in a mesh",
-     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_zero_area, NULL, {0}},
+     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_zero_area, NULL, {0}, NULL},
     {"needle_triangles", GROUP_GEOMETRY, "triangles 2 long and 1e-6 wide",
-     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_needles, NULL, {0}},
+     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_needles, NULL, {0}, NULL},
     {"duplicated_vertices", GROUP_GEOMETRY, "an unwelded box listed twice, with reversed duplicates of its triangles",
-     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_duplicated, NULL, {0}},
+     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_duplicated, NULL, {0}, NULL},
     {"mesh_with_holes", GROUP_GEOMETRY, "a box missing two faces",
-     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_holes, NULL, {0}},
+     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_holes, NULL, {0}, NULL},
     {"single_triangle", GROUP_GEOMETRY, "a scene of one triangle",
-     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_single_triangle, NULL, {0}},
+     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_single_triangle, NULL, {0}, NULL},
     {"triangles_1e6", GROUP_GEOMETRY, "1,002,528 triangles of self-shadowing bumps",
-     LIGHTS_ALL, PLAN_ONE, true, false, false, geo_million, NULL, {0}},
+     LIGHTS_ALL, PLAN_ONE, true, false, false, geo_million, NULL, {0}, NULL},
     {"coordinates_near_1e6", GROUP_GEOMETRY, "the scene at x = z = 1e6 with a box of 1e-3 (below the float ulp 0.0625)",
-     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_far_coordinates, NULL, {0}},
+     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_far_coordinates, NULL, {0}, NULL},
     {"every_pixel_background", GROUP_GEOMETRY, "camera looking at the empty sky",
-     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_background, limit_all_background, {0}},
+     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_background, limit_all_background, {0}, NULL},
     {"camera_inside_object", GROUP_GEOMETRY, "camera inside the closed box",
-     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_camera_inside, NULL, {0}},
+     LIGHTS_ALL, PLAN_TWO, false, false, false, geo_camera_inside, NULL, {0}, NULL},
 
-    {"near_1e-6", GROUP_CAMERA, "near plane at 1e-6", LIGHTS_ALL, PLAN_TWO, false, false, false, cam_near_tiny, NULL, {0}},
-    {"far_over_near_1e6", GROUP_CAMERA, "near 1e-3, far 1e3", LIGHTS_ALL, PLAN_TWO, false, false, false, cam_far_near, NULL, {0}},
-    {"fov_1deg", GROUP_CAMERA, "vertical field of view 1 degree", LIGHTS_ALL, PLAN_TWO, false, false, false, cam_fov_1, NULL, {0}},
-    {"fov_170deg", GROUP_CAMERA, "vertical field of view 170 degrees", LIGHTS_ALL, PLAN_TWO, false, false, false, cam_fov_170, NULL, {0}},
-    {"image_1x1", GROUP_CAMERA, "a 1 x 1 image", LIGHTS_ALL, PLAN_TWO, false, false, false, cam_1x1, NULL, {0}},
-    {"image_4096x4096", GROUP_CAMERA, "a 4096 x 4096 image", LIGHTS_ALL, PLAN_ONE, true, false, false, cam_4096, NULL, {0}},
+    {"near_1e-6", GROUP_CAMERA, "near plane at 1e-6", LIGHTS_ALL, PLAN_TWO, false, false, false, cam_near_tiny, NULL, {0}, NULL},
+    {"far_over_near_1e6", GROUP_CAMERA, "near 1e-3, far 1e3", LIGHTS_ALL, PLAN_TWO, false, false, false, cam_far_near, NULL, {0}, NULL},
+    {"fov_1deg", GROUP_CAMERA, "vertical field of view 1 degree", LIGHTS_ALL, PLAN_TWO, false, false, false, cam_fov_1, NULL, {0}, NULL},
+    {"fov_170deg", GROUP_CAMERA, "vertical field of view 170 degrees", LIGHTS_ALL, PLAN_TWO, false, false, false, cam_fov_170, NULL, {0}, NULL},
+    {"image_1x1", GROUP_CAMERA, "a 1 x 1 image", LIGHTS_ALL, PLAN_TWO, false, false, false, cam_1x1, NULL, {0}, NULL},
+    {"image_4096x4096", GROUP_CAMERA, "a 4096 x 4096 image", LIGHTS_ALL, PLAN_ONE, true, false, false, cam_4096, NULL, {0}, NULL},
 
     {"nan_vertex_obj", GROUP_INPUT, "OBJ vertex 'nan': refused with file and line", 0, PLAN_NONE, false, false, false,
-     in_nan_vertex_obj, NULL, {"bad.obj:2", "not finite"}},
+     in_nan_vertex_obj, NULL, {"bad.obj:2", "not finite"}, NULL},
     {"inf_vertex_obj", GROUP_INPUT, "OBJ vertex 'inf': refused with file and line", 0, PLAN_NONE, false, false, false,
-     in_inf_vertex_obj, NULL, {"bad.obj:2", "not finite"}},
+     in_inf_vertex_obj, NULL, {"bad.obj:2", "not finite"}, NULL},
     {"inf_vertex_ply", GROUP_INPUT, "binary PLY vertex +Inf: refused with file and record", 0, PLAN_NONE, false, false, false,
-     in_inf_vertex_ply, NULL, {"bad.ply", "not finite"}},
+     in_inf_vertex_ply, NULL, {"bad.ply", "not finite"}, NULL},
     {"vertex_overflows_after_transform", GROUP_INPUT, "vertex 1e38 scaled by 1e7: refused after its transform", 0,
-     PLAN_NONE, false, false, false, in_overflow_transform, NULL, {"objects[4]", "not finite"}},
+     PLAN_NONE, false, false, false, in_overflow_transform, NULL, {"objects[4]", "not finite"}, NULL},
     {"nan_translate", GROUP_INPUT, "translate = {0/0, 1, 0}: refused with the key path", 0, PLAN_NONE, false, false, false,
-     in_nan_translate, NULL, {"objects[4].translate[1]", "outside"}},
+     in_nan_translate, NULL, {"objects[4].translate[1]", "outside"}, NULL},
     {"nan_heightfield", GROUP_INPUT, "elevation returning 0/0: refused with the key path", 0, PLAN_NONE, false, false, false,
-     in_nan_elevation, NULL, {"objects[4].elevation", "nan"}},
+     in_nan_elevation, NULL, {"objects[4].elevation", "nan"}, NULL},
     {"nan_light_position", GROUP_INPUT, "light position {0, 0/0, 0}: refused with the key path", 0, PLAN_NONE, false,
-     false, false, in_nan_light_position, NULL, {"lights[1].position[2]", "outside"}},
+     false, false, in_nan_light_position, NULL, {"lights[1].position[2]", "outside"}, NULL},
     {"inf_light_position", GROUP_INPUT, "light position {0, 1/0, 0}: refused with the key path", 0, PLAN_NONE, false,
-     false, false, in_inf_light_position, NULL, {"lights[1].position[2]", "outside"}},
+     false, false, in_inf_light_position, NULL, {"lights[1].position[2]", "outside"}, NULL},
     {"nan_light_radius", GROUP_INPUT, "light radius 0/0: refused with the key path and range", 0, PLAN_NONE, false,
-     false, false, in_nan_light_radius, NULL, {"lights[1].radius", "(0, 1e+07]"}},
+     false, false, in_nan_light_radius, NULL, {"lights[1].radius", "(0, 1e+07]"}, NULL},
     {"nan_light_direction", GROUP_INPUT, "light direction {0/0, -1, 0}: refused with the key path", 0, PLAN_NONE,
-     false, false, false, in_nan_light_direction, NULL, {"lights[1].direction[1]", "outside"}},
+     false, false, false, in_nan_light_direction, NULL, {"lights[1].direction[1]", "outside"}, NULL},
     {"nan_light_image", GROUP_INPUT, "light image with a NaN texel: refused naming the file and texel", 0, PLAN_NONE,
-     false, false, false, in_nan_light_image, NULL, {"bad-light.exr", "texel"}},
+     false, false, false, in_nan_light_image, NULL, {"bad-light.exr", "texel"}, NULL},
     {"inf_light_image", GROUP_INPUT, "light image with an Inf texel: refused naming the file and texel", 0, PLAN_NONE,
-     false, false, false, in_inf_light_image, NULL, {"bad-light.exr", "texel"}},
+     false, false, false, in_inf_light_image, NULL, {"bad-light.exr", "texel"}, NULL},
     {"negative_light_image", GROUP_INPUT, "light image with a negative texel: refused naming the file and texel", 0,
-     PLAN_NONE, false, false, false, in_negative_light_image, NULL, {"bad-light.exr", "texel"}},
+     PLAN_NONE, false, false, false, in_negative_light_image, NULL, {"bad-light.exr", "texel"}, NULL},
     {"nan_camera", GROUP_INPUT, "camera fov and position NaN: refused with the key path", 0, PLAN_NONE, false, false, false,
-     in_nan_camera, NULL, {"camera.fov", "(0, 180)"}},
+     in_nan_camera, NULL, {"camera.fov", "(0, 180)"}, NULL},
     {"scene_triangle_budget", GROUP_INPUT, "five 2048-segment spheres (21M triangles): refused at the scene's triangle budget", 0,
-     PLAN_NONE, false, false, false, in_triangle_budget, NULL, {"objects[7]", "triangle"}},
+     PLAN_NONE, false, false, false, in_triangle_budget, NULL, {"objects[7]", "triangle"}, NULL},
 };
 
 int stab_cases_count(void) { return (int)(sizeof cases / sizeof cases[0]); }

@@ -70,7 +70,18 @@ typedef struct StabCase {
      * Returns false with the reason in `why`. */
     bool (*limit)(const Metrics *m, char *why, size_t n);
     const char *refusal[3];        /* PLAN_NONE: words the refusal must contain */
+    const struct KnownLimit *known;/* techniques known to miss `limit` here; ends at a NULL reason */
 } StabCase;
+
+/* A technique (NULL: every technique that acquires a shadow map) that
+ * misses a case's limit under the given light kinds for a reason its
+ * source states: its rows are STAB_KNOWN, and STAB_FAIL if the limit holds. */
+typedef struct KnownLimit {
+    const char *technique;
+    unsigned lights;
+    const char *reason;
+} KnownLimit;
+const KnownLimit *stab_known_limit(const StabCase *c, const Technique *t, LightKind kind);
 
 /* Probes generated from each ParamDesc of a technique. */
 typedef enum ParamProbe {
