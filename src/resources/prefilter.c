@@ -692,26 +692,36 @@ int minmax_buffer_level(int K)
     return level;
 }
 
-/* Level k from level k - 1: the four blocks of half the size at offsets
- * (0 or h, 0 or h), h = 2^(k-1), indices clamped to the face. */
-static void buffer_double(const float *in, float *out, int res, int faces, int half)
+/* Level k from level k - 1, in place: the four blocks of half the size at
+ * offsets (0 or h, 0 or h), h = 2^(k-1), indices clamped to the face, as a
+ * min/max along x and then along y (the four offsets are their product, and
+ * the clamps are per axis). Each pass reads only entries ahead of the one it
+ * writes along its own line, so lines (rows, then column strips) run in
+ * parallel with no second buffer. */
+#define NBUFFER_STRIP 64
+static void buffer_double(float *mm, int res, int faces, int half)
 {
-    int rows = faces * res;
+    int rows = faces * res, strips = (res + NBUFFER_STRIP - 1) / NBUFFER_STRIP;
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < rows; r++) {
-        int f = r / res, j = r % res;
+        float *row = mm + 2 * (size_t)r * res;
         for (int i = 0; i < res; i++) {
-            float lo = INFINITY, hi = -INFINITY;
-            for (int b = 0; b < 2; b++)
-                for (int a = 0; a < 2; a++) {
-                    const float *q = in + 2 * (((size_t)f * res + clampi(j + b * half, 0, res - 1)) * res +
-                                               clampi(i + a * half, 0, res - 1));
-                    lo = fminf(lo, q[0]);
-                    hi = fmaxf(hi, q[1]);
-                }
-            float *o = out + 2 * (((size_t)f * res + j) * res + i);
-            o[0] = lo;
-            o[1] = hi;
+            const float *q = row + 2 * (size_t)clampi(i + half, 0, res - 1);
+            row[2 * i] = fminf(row[2 * i], q[0]);
+            row[2 * i + 1] = fmaxf(row[2 * i + 1], q[1]);
+        }
+    }
+#pragma omp parallel for schedule(static)
+    for (int t = 0; t < faces * strips; t++) {
+        int f = t / strips, i0 = (t % strips) * NBUFFER_STRIP, i1 = i0 + NBUFFER_STRIP < res ? i0 + NBUFFER_STRIP : res;
+        float *face = mm + 2 * (size_t)f * res * res;
+        for (int j = 0; j < res; j++) {
+            float *row = face + 2 * (size_t)j * res;
+            const float *ahead = face + 2 * (size_t)clampi(j + half, 0, res - 1) * res;
+            for (int i = i0; i < i1; i++) {
+                row[2 * i] = fminf(row[2 * i], ahead[2 * i]);
+                row[2 * i + 1] = fmaxf(row[2 * i + 1], ahead[2 * i + 1]);
+            }
         }
     }
 }
@@ -722,25 +732,15 @@ static void *build_buffer(const void *args, Error *err)
     const ShadowMap *m = a->map;
     size_t n = (size_t)m->num_faces * m->res * m->res;
     MinMaxBuffer *b = calloc(1, sizeof *b);
-    float *other = a->level > 0 ? malloc(n * 2 * sizeof *other) : NULL;
     if (b) b->minmax = malloc(n * 2 * sizeof *b->minmax);
-    if (!b || !b->minmax || (a->level > 0 && !other)) {
-        free(other);
+    if (!b || !b->minmax) {
         if (b) buffer_destroy(b);
         error_set(err, "out of memory for a %d^2 min-max N-buffer", m->res);
         return NULL;
     }
     *b = (MinMaxBuffer){a->key, m->res, m->num_faces, a->level, b->minmax};
-    /* Level 0 goes where the last doubling will land, so the result ends in b->minmax. */
-    float *cur = a->level % 2 ? other : b->minmax, *next = a->level % 2 ? b->minmax : other;
-    for (size_t k = 0; k < n; k++) cur[2 * k] = cur[2 * k + 1] = m->depth[k];
-    for (int l = 1; l <= a->level; l++) {
-        buffer_double(cur, next, m->res, m->num_faces, 1 << (l - 1));
-        float *t = cur;
-        cur = next;
-        next = t;
-    }
-    free(other);
+    for (size_t k = 0; k < n; k++) b->minmax[2 * k] = b->minmax[2 * k + 1] = m->depth[k];
+    for (int l = 1; l <= a->level; l++) buffer_double(b->minmax, m->res, m->num_faces, 1 << (l - 1));
     return b;
 }
 
