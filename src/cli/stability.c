@@ -124,21 +124,15 @@ int cmd_stability(int argc, char **argv)
     }
     Rows rows = {0};
     ok = run_suite(&c, t, &rows, &err);
-    int failed = 0, passed = 0, na = 0, known = 0;
-    for (int i = 0; i < rows.n; i++) {
-        failed += rows.rows[i].status == STAB_FAIL;
-        passed += rows.rows[i].status == STAB_PASS;
-        na += rows.rows[i].status == STAB_NOT_APPLICABLE;
-        known += rows.rows[i].status == STAB_KNOWN;
-    }
+    StabCounts n = stab_count(rows.rows, rows.n);
     free(rows.rows);
     if (!ok) {
         fprintf(stderr, "shadowlab stability: %s\n", err.msg);
         return EXIT_RUNTIME;
     }
     if (c.out_dir) printf("report: %s/stability.{json,csv,md}\n", c.out_dir);
-    printf("not applicable: %d\n", na);
-    printf("known limitations (documented, not counted as passed): %d\n", known);
-    printf("stability: %d passed, %d failed\n", passed, failed);
-    return failed ? EXIT_RUNTIME : EXIT_OK;
+    printf("not applicable: %d\n", n.na);
+    printf("known limitations (documented, not counted as passed): %d\n", n.known);
+    printf("stability: %d passed, %d failed\n", n.pass, n.fail);
+    return n.fail ? EXIT_RUNTIME : EXIT_OK;
 }

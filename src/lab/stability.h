@@ -73,6 +73,10 @@ int stab_case_count(void);
 const char *stab_case_name(int i);
 const char *stab_case_doc(int i);
 
+/* Rows by status: what the CLI prints and the report heads with. */
+typedef struct StabCounts { int pass, fail, na, known; } StabCounts;
+StabCounts stab_count(const StabResult *rows, int n);
+
 /* Write DIR/stability.{json,csv,md} atomically: the matrix (rows in their
  * `order`) with counts, errors and times, and the options it ran with. */
 bool stab_report_write(const char *dir, const StabResult *rows, int n, const StabOptions *o, Error *err);
