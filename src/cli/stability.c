@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <unistd.h>
 #include "cli/cli.h"
+#include "core/array.h"
 #include "core/progress.h"
 #include "lab/stability.h"
 
@@ -55,16 +56,12 @@ static void on_row(const StabResult *r, void *user)
     Rows *rs = user;
     print_row(r);
     progress_add(rs->progress, 1);
-    if (rs->n == rs->cap) {
-        int cap = rs->cap ? 2 * rs->cap : 256;
-        StabResult *p = realloc(rs->rows, sizeof *p * (size_t)cap);
-        if (!p) {
-            rs->oom = true;
-            return;
-        }
-        rs->rows = p;
-        rs->cap = cap;
+    StabResult *rows = array_room(rs->rows, rs->n, &rs->cap, sizeof *rows, 256);
+    if (!rows) {
+        rs->oom = true;
+        return;
     }
+    rs->rows = rows;
     rs->rows[rs->n++] = *r;
 }
 

@@ -18,6 +18,7 @@
 #include "io/exr.h"
 #include "lab/stability_cases.h"
 #include "lab/stability_proc.h"
+#include "core/array.h"
 
 #define DEFAULT_TIMEOUT_S 120.0
 #define PREP_BOUNDS 3      /* a case's shared preparation: this many runs' time bound */
@@ -126,16 +127,12 @@ static bool wanted(const Runner *rn, const char *case_name)
 static void add_job(Runner *rn, const Technique *t, const StabCase *c, int param, ParamProbe probe, LightKind kind,
                     const char *name)
 {
-    if (rn->num_jobs == rn->cap) {
-        int cap = rn->cap ? 2 * rn->cap : 256;
-        StabJob *p = realloc(rn->jobs, sizeof *p * (size_t)cap);
-        if (!p) {
-            rn->oom = true;
-            return;
-        }
-        rn->jobs = p;
-        rn->cap = cap;
+    StabJob *jobs = array_room(rn->jobs, rn->num_jobs, &rn->cap, sizeof *jobs, 256);
+    if (!jobs) {
+        rn->oom = true;
+        return;
     }
+    rn->jobs = jobs;
     StabJob *j = &rn->jobs[rn->num_jobs++];
     *j = (StabJob){t, c, param, probe, kind, rn->st, rn->threads, rn->order++, ""};
     snprintf(j->name, sizeof j->name, "%s", name);

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "raster/clip.h"
+#include "core/array.h"
 
 #define SUB (1 << RASTER_SUBPIXEL_BITS) /* sub-texel steps per texel */
 #define HALF (SUB / 2)                  /* texel centre offset */
@@ -204,13 +205,9 @@ static void transform_vertices(const Setup *s, const RasterMesh *m, Vertices *ou
 
 static bool push_tri(ThreadTris *tt, const SnapTri *t)
 {
-    if (tt->count == tt->cap) {
-        int cap = tt->cap ? 2 * tt->cap : 1024;
-        SnapTri *n = realloc(tt->tri, sizeof *n * (size_t)cap);
-        if (!n) return false;
-        tt->tri = n;
-        tt->cap = cap;
-    }
+    SnapTri *tri = array_room(tt->tri, tt->count, &tt->cap, sizeof *tri, 1024);
+    if (!tri) return false;
+    tt->tri = tri;
     tt->tri[tt->count++] = *t;
     return true;
 }

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/array.h"
 #include "core/progress.h"
 #include "core/timer.h"
 
@@ -70,13 +71,9 @@ static void int_list_add_unique(IntList *l, int v)
 {
     for (int i = 0; i < l->n; i++)
         if (l->v[i] == v) return;
-    if (l->n == l->cap) {
-        int cap = l->cap ? 2 * l->cap : 8;
-        int *nv = realloc(l->v, sizeof *nv * (size_t)cap);
-        if (!nv) return;
-        l->v = nv;
-        l->cap = cap;
-    }
+    int *values = array_room(l->v, l->n, &l->cap, sizeof *values, 8);
+    if (!values) return;
+    l->v = values;
     l->v[l->n++] = v;
 }
 
@@ -85,13 +82,9 @@ static bool event_add(EventList *l, const Entry *e, const char *desc, bool built
 {
     for (int i = 0; i < l->n; i++)
         if (l->ev[i].key == e->key && strcmp(l->ev[i].kind, e->kind->name) == 0) return false;
-    if (l->n == l->cap) {
-        int cap = l->cap ? 2 * l->cap : 16;
-        ResourceEvent *nl = realloc(l->ev, sizeof *nl * (size_t)cap);
-        if (!nl) return false;
-        l->ev = nl;
-        l->cap = cap;
-    }
+    ResourceEvent *events = array_room(l->ev, l->n, &l->cap, sizeof *events, 16);
+    if (!events) return false;
+    l->ev = events;
     ResourceEvent *ev = &l->ev[l->n++];
     ev->kind = e->kind->name;
     snprintf(ev->desc, sizeof ev->desc, "%s", desc);
@@ -138,17 +131,13 @@ static int build_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t k
     progress_end(&prog);
     rm->depth--;
     if (!res) return -1;
-    if (rm->count == rm->cap) {
-        int cap = rm->cap ? 2 * rm->cap : 16;
-        Entry *ne = realloc(rm->entries, sizeof *ne * (size_t)cap);
-        if (!ne) {
-            kind->destroy(res);
-            error_set(err, "out of memory in the resource manager");
-            return -1;
-        }
-        rm->entries = ne;
-        rm->cap = cap;
+    Entry *entries = array_room(rm->entries, rm->count, &rm->cap, sizeof *entries, 16);
+    if (!entries) {
+        kind->destroy(res);
+        error_set(err, "out of memory in the resource manager");
+        return -1;
     }
+    rm->entries = entries;
     Entry *e = &rm->entries[rm->count];
     *e = (Entry){kind, key, res, dt, dt > f->nested_s ? dt - f->nested_s : 0.0, kind->bytes(res), "", {NULL, 0, 0}};
     snprintf(e->desc, sizeof e->desc, "%s", desc);
