@@ -104,6 +104,20 @@ double bench_median(const double *v, int n)
     return m;
 }
 
+bool bench_paired(BenchPairFn round, void *run, int repeat, double med[3], Error *err)
+{
+    double *t = malloc(sizeof *t * 3 * (size_t)repeat), a_s, b_s;
+    if (!t) return error_set(err, "out of memory");
+    bool ok = round(run, &a_s, &b_s, err);
+    for (int i = 0; ok && i < repeat; i++) {
+        ok = round(run, &t[i], &t[repeat + i], err);
+        t[2 * repeat + i] = t[i] / t[repeat + i];
+    }
+    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * repeat, repeat);
+    free(t);
+    return ok;
+}
+
 int bench_casters(const Scene *scene, RasterMesh *out, int max, long *triangles)
 {
     int n = 0;

@@ -51,6 +51,12 @@ int bench_fail(const char *program, const Error *err);
 /* Median of n values (n >= 1; sorts a copy). */
 double bench_median(const double *v, int n);
 
+/* One round of a two-sided comparison: the seconds of side a and side b. */
+typedef bool (*BenchPairFn)(void *run, double *a_s, double *b_s, Error *err);
+/* An untimed warm-up round, then `repeat` rounds; med = {median of a,
+ * median of b, median of the per-round ratios a / b}. */
+bool bench_paired(BenchPairFn round, void *run, int repeat, double med[3], Error *err);
+
 /* The scene's casters as the rasterizer reads them (at most `max` meshes);
  * returns the mesh count, or -1 when there are more. */
 int bench_casters(const Scene *scene, RasterMesh *out, int max, long *triangles);

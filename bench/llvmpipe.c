@@ -200,8 +200,9 @@ static bool depth_agrees(const DepthAgreement *a)
 /* One round: each side draws twice back to back and the second draw is
  * timed, so both run with warm caches and awake threads rather than
  * inheriting the other's cache state and sleeping worker pool. */
-static bool depth_round(DepthRun *r, double *gl_s, double *ours_s, Error *err)
+static bool depth_round(void *run, double *gl_s, double *ours_s, Error *err)
 {
+    DepthRun *r = run;
     bool ok = true;
     RasterStats st;
     for (int k = 0; k < 2; k++) *gl_s = gl_timed(gl_depth_draw, r);
@@ -211,20 +212,6 @@ static bool depth_round(DepthRun *r, double *gl_s, double *ours_s, Error *err)
         *ours_s = timer_now_s() - t0;
     }
     return ok && gl_check("the depth pass", err);
-}
-
-static bool depth_measure(DepthRun *r, const Options *o, double med[3], Error *err)
-{
-    double *t = malloc(sizeof *t * 3 * (size_t)o->c.repeat), gl_s, ours_s;
-    if (!t) return error_set(err, "out of memory");
-    bool ok = depth_round(r, &gl_s, &ours_s, err); /* warm-up */
-    for (int i = 0; ok && i < o->c.repeat; i++) {
-        ok = depth_round(r, &t[i], &t[o->c.repeat + i], err);
-        t[2 * o->c.repeat + i] = t[i] / t[o->c.repeat + i];
-    }
-    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->c.repeat, o->c.repeat);
-    free(t);
-    return ok;
 }
 
 static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c, int res, const double med[3],
@@ -256,7 +243,8 @@ static bool bench_depth(Lab *lab, const Casters *c, const GlContext *gl, const O
     r.target = &target;
     float *gl_depth = malloc(sizeof *gl_depth * (size_t)res * res);
     double med[3];
-    bool ok = gl_depth && depth_buffer_init(&r.db, res, res, false, err) && depth_measure(&r, o, med, err);
+    bool ok = gl_depth && depth_buffer_init(&r.db, res, res, false, err) &&
+              bench_paired(depth_round, &r, o->c.repeat, med, err);
     if (ok) {
         glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
         glPixelStorei(GL_PACK_ALIGNMENT, 4);
@@ -428,9 +416,11 @@ static bool pcf_params(const Options *o, int K, double *params, const Technique 
     return tech_param_parse(*t, "kernel=box", params, err);
 }
 
-/* The evaluation alone (eval_median_s of one timed evaluation). */
-static bool pcf_round(PcfRun *r, double *gl_s, double *ours_s, Error *err)
+/* The evaluation alone (eval_median_s of one timed evaluation); the
+ * untimed first round builds the map and JITs the shader. */
+static bool pcf_round(void *run, double *gl_s, double *ours_s, Error *err)
 {
+    PcfRun *r = run;
     *gl_s = gl_timed(gl_pcf_draw, r);
     render_result_free(&r->last);
     if (!lab_render(r->lab, &r->req, &r->last, err)) return false;
@@ -479,24 +469,10 @@ static bool write_pcf_row(const Options *o, const Scene *sc, int K, const double
     return bench_csv_append(path, PCF_HEADER, row, err);
 }
 
-static bool pcf_measure(PcfRun *r, const Options *o, double med[3], Error *err)
-{
-    double *t = malloc(sizeof *t * 3 * (size_t)o->c.repeat), gl_s, ours_s;
-    if (!t) return error_set(err, "out of memory");
-    bool ok = pcf_round(r, &gl_s, &ours_s, err); /* warm-up: builds the map, JITs the shader */
-    for (int i = 0; ok && i < o->c.repeat; i++) {
-        ok = pcf_round(r, &t[i], &t[o->c.repeat + i], err);
-        t[2 * o->c.repeat + i] = t[i] / t[o->c.repeat + i];
-    }
-    for (int k = 0; ok && k < 3; k++) med[k] = bench_median(t + k * o->c.repeat, o->c.repeat);
-    free(t);
-    return ok;
-}
-
 static bool bench_pcf_K(PcfRun *r, const Options *o, const uint8_t *cls, const char *renderer, Error *err)
 {
     double med[3];
-    if (!pcf_measure(r, o, med, err)) return false;
+    if (!bench_paired(pcf_round, r, o->c.repeat, med, err)) return false;
     const Scene *sc = lab_scene(r->lab);
     float *gl_vis = malloc(sizeof *gl_vis * (size_t)sc->camera.width * sc->camera.height);
     if (!gl_vis) return error_set(err, "out of memory");
