@@ -134,9 +134,7 @@ static bool bench_tech(const Options *o, const Technique *t, Error *err)
 /* A map technique (one that acquires a shadow_map) that -t selects. */
 static bool wanted(const Options *o, const Technique *t)
 {
-    bool map = false;
-    for (int k = 0; t->resources && t->resources[k]; k++) map |= strcmp(t->resources[k], "shadow_map") == 0;
-    if (!map) return false;
+    if (!tech_acquires(t, "shadow_map")) return false;
     for (int i = 0; i < o->num_techs; i++)
         if (strcmp(o->techs[i], t->name) == 0) return true;
     return o->num_techs == 0;

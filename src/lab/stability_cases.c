@@ -8,7 +8,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
-#include "techniques/technique.h"
+#include "techniques/registry.h"
 
 #define DEG (M_PI / 180.0)
 
@@ -256,17 +256,10 @@ static const KnownLimit inside_occluder_known[] = {
     {NULL, 0, NULL},
 };
 
-static bool acquires_shadow_map(const Technique *t)
-{
-    for (const char *const *r = t->resources; r && *r; r++)
-        if (strcmp(*r, "shadow_map") == 0) return true;
-    return false;
-}
-
 const KnownLimit *stab_known_limit(const StabCase *c, const Technique *t, LightKind kind)
 {
     for (const KnownLimit *k = c->known; t && k && k->reason; k++) {
-        bool tech = k->technique ? strcmp(k->technique, t->name) == 0 : acquires_shadow_map(t);
+        bool tech = k->technique ? strcmp(k->technique, t->name) == 0 : tech_acquires(t, "shadow_map");
         if (tech && (k->lights & LIGHT_BIT(kind))) return k;
     }
     return NULL;

@@ -72,6 +72,13 @@ void tech_lights_text(const Technique *t, char *out, size_t n)
             used += (size_t)snprintf(out + used, n - used, "%s%s", used ? ", " : "", light_kind_name((LightKind)k));
 }
 
+bool tech_acquires(const Technique *t, const char *kind)
+{
+    for (const char *const *r = t->resources; r && *r; r++)
+        if (strcmp(*r, kind) == 0) return true;
+    return false;
+}
+
 bool tech_check_light(const Technique *t, const Light *light, int light_number, Error *err)
 {
     if (t->lights & LIGHT_BIT(light->kind)) return true;

@@ -32,5 +32,7 @@ const char *param_type_name(ParamType t);
 void tech_lights_text(const Technique *t, char *out, size_t n);
 /* Refuse a light the technique does not handle, naming what it handles. */
 bool tech_check_light(const Technique *t, const Light *light, int light_number, Error *err);
+/* Does the technique declare resource kind `kind` (Technique.resources)? */
+bool tech_acquires(const Technique *t, const char *kind);
 
 #endif
