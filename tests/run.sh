@@ -17,7 +17,28 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:exitcode=86"
 export LSAN_OPTIONS="suppressions=$(pwd)/tests/lsan.supp:print_suppressions=0"
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
-"./$B/test_unit_san" 2>&1 | tee "$log"
+# A sanitized test binary, run once more only when LeakSanitizer's own
+# tracer died at exit ("LeakSanitizer has encountered a fatal error": its
+# stop-the-world thread caught a signal, seen once in four fresh runs of the
+# unit binary on the shared VM, not reproduced in the next runs) and nothing
+# was reported on the code: no leak, ASan or UBSan report. The rerun keeps
+# every check, leaks included; its output alone goes to the log.
+san_run() {
+    local out status
+    out=$(mktemp)
+    "$@" > "$out" 2>&1
+    status=$?
+    if [ "$status" -ne 0 ] && grep -q "LeakSanitizer has encountered a fatal error" "$out" &&
+        ! grep -qE "ERROR: (LeakSanitizer|AddressSanitizer)|runtime error:" "$out"; then
+        echo "($1: LeakSanitizer's tracer failed at exit, not a report on the code: running it again)"
+        "$@" > "$out" 2>&1
+        status=$?
+    fi
+    cat "$out"
+    rm -f "$out"
+    return "$status"
+}
+san_run "./$B/test_unit_san" | tee "$log"
 unit_status=$?
 SHADOWLAB_CACHE=$(mktemp -d) ./tests/cli/run.sh "$B/shadowlab_san" 2>&1 | tee -a "$log"
 ./tests/lua/run.sh "$B/shadowlab" 2>&1 | tee -a "$log"
@@ -27,7 +48,7 @@ SHADOWLAB_CACHE=$(mktemp -d) ./tests/cli/run.sh "$B/shadowlab_san" 2>&1 | tee -a
 # same under ASan + UBSan but for image_4096x4096 (its runs take ~100 s of
 # their 120 s bound there: a loaded machine would time them out); then the
 # short fuzz run, the valgrind runs and the kill test of atomic outputs.
-"./$B/test_stability_san" 2>&1 | tee -a "$log"
+san_run "./$B/test_stability_san" | tee -a "$log"
 "./$B/shadowlab" stability --quick --jobs 2 --threads 1 2>&1 | tee -a "$log"
 "./$B/shadowlab_san" stability --quick --jobs 2 --threads 1 --case '!image_4096x4096' 2>&1 | tee -a "$log"
 ./tests/fuzz/run.sh "$B" 2>&1 | tee -a "$log"
