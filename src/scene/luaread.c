@@ -1,6 +1,7 @@
 /* luaread.c -- validated Lua table fields with key paths (see luaread.h). */
 #include "scene/luaread.h"
 #include <lauxlib.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -73,6 +74,64 @@ bool rd_only_keys(LuaReader *r, int idx, const char *const *allowed)
         }
     }
     return true;
+}
+
+/* Enter the path step of the key at the top of the stack (a string, an
+ * integer index, or any other key by its type name). */
+static size_t enter_any_key(LuaReader *r)
+{
+    lua_State *L = r->L;
+    if (lua_type(L, -1) == LUA_TSTRING) return rd_enter_key(r, lua_tostring(L, -1));
+    if (lua_isinteger(L, -1) && lua_tointeger(L, -1) >= INT_MIN && lua_tointeger(L, -1) <= INT_MAX)
+        return rd_enter_index(r, (int)lua_tointeger(L, -1));
+    size_t n = strlen(r->path);
+    snprintf(r->path + n, sizeof r->path - n, "[%s key]", luaL_typename(L, -1));
+    return n;
+}
+
+/* The walk behind rd_refuse_metatables: `seen` (a table at stack index
+ * seen_idx) holds the tables already checked, so shared and cyclic tables are
+ * walked once. The key path names the table being checked. */
+static bool refuse_metatables_at(LuaReader *r, int idx, int seen_idx, int depth)
+{
+    lua_State *L = r->L;
+    if (lua_getmetatable(L, idx)) {
+        lua_pop(L, 1);
+        return rd_fail(r, NULL, "has a metatable: metatables are not allowed in scene tables (their metamethods "
+                                "would run while the scene is read)");
+    }
+    if (depth > RD_MAX_DEPTH) return rd_fail(r, NULL, "nests tables deeper than %d levels", RD_MAX_DEPTH);
+    lua_pushvalue(L, idx);
+    if (lua_rawget(L, seen_idx) != LUA_TNIL) { lua_pop(L, 1); return true; }
+    lua_pop(L, 1);
+    lua_pushvalue(L, idx);
+    lua_pushboolean(L, 1);
+    lua_rawset(L, seen_idx);
+    luaL_checkstack(L, 4, "scene tables nest too deeply");
+    lua_pushnil(L);
+    while (lua_next(L, idx)) { /* key at -2, value at -1 */
+        int top = lua_gettop(L);
+        lua_pushvalue(L, top - 1);
+        size_t saved = enter_any_key(r);
+        lua_pop(L, 1);
+        bool ok = (lua_type(L, top - 1) != LUA_TTABLE || refuse_metatables_at(r, top - 1, seen_idx, depth + 1)) &&
+                  (lua_type(L, top) != LUA_TTABLE || refuse_metatables_at(r, top, seen_idx, depth + 1));
+        rd_leave(r, saved);
+        if (!ok) return false;
+        lua_settop(L, top - 1);
+    }
+    return true;
+}
+
+bool rd_refuse_metatables(LuaReader *r, int idx)
+{
+    lua_State *L = r->L;
+    int top = lua_gettop(L);
+    idx = lua_absindex(L, idx);
+    lua_newtable(L);
+    bool ok = refuse_metatables_at(r, idx, lua_gettop(L), 0);
+    lua_settop(L, top);
+    return ok;
 }
 
 bool rd_get(LuaReader *r, int idx, const char *key)

@@ -27,6 +27,15 @@ size_t rd_enter_key(LuaReader *r, const char *key);
 size_t rd_enter_index(LuaReader *r, int index);
 void rd_leave(LuaReader *r, size_t saved);
 
+/* Refuse a metatable on the table at idx or on any table reachable from it
+ * (keys and values, at any depth): the reader's lua_getfield, luaL_len and
+ * luaL_tolstring would run __index, __len or __tostring, and a metamethod
+ * could error, loop or allocate where no protected call catches it. Nesting
+ * deeper than RD_MAX_DEPTH is refused too (the walk recurses in C). Names the
+ * key path of the offending table. */
+#define RD_MAX_DEPTH 32
+bool rd_refuse_metatables(LuaReader *r, int idx);
+
 /* Refuse keys of the table at idx that are not in `allowed` (NULL-terminated). */
 bool rd_only_keys(LuaReader *r, int idx, const char *const *allowed);
 /* Push t[key]; returns false (nothing pushed) when absent. */

@@ -199,6 +199,17 @@ bool sandbox_run_file(Sandbox *sb, const char *path, Error *err)
     return true;
 }
 
+bool sandbox_protected(Sandbox *sb, lua_CFunction fn, void *ud, const char *path, Error *err)
+{
+    lua_State *L = sb->L;
+    int table = lua_gettop(L);
+    if (!lua_checkstack(L, 3)) return error_set(err, "%s: out of Lua stack", path);
+    lua_pushcfunction(L, fn);
+    lua_pushvalue(L, table);
+    lua_pushlightuserdata(L, ud);
+    return pcall_or_error(L, path, 2, 0, err);
+}
+
 /* Push the value of an override's right-hand side. */
 static void push_override_value(lua_State *L, const char *text)
 {
@@ -254,7 +265,7 @@ bool sandbox_apply_override(Sandbox *sb, const char *spec, Error *err)
             return error_set(err, "override '%s': malformed key path near '%s'", spec, s);
         }
         if (*s == '\0') break;
-        lua_gettable(L, -2);
+        lua_rawget(L, -2);
         if (!lua_istable(L, -1)) {
             lua_settop(L, top);
             return error_set(err, "override '%s': '%.*s' is not a table in the scene", spec, (int)(s - path), path);
@@ -262,7 +273,7 @@ bool sandbox_apply_override(Sandbox *sb, const char *spec, Error *err)
         lua_remove(L, -2);
     }
     push_override_value(L, eq + 1);
-    lua_settable(L, -3);
+    lua_rawset(L, -3);
     lua_settop(L, top);
     return true;
 }

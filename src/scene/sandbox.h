@@ -27,8 +27,16 @@ lua_State *sandbox_state(Sandbox *sb);
 bool sandbox_run_file(Sandbox *sb, const char *path, Error *err);
 /* Apply "a.b[2].c=value" to the table on top of the stack. The value is read
  * as a Lua expression (number, boolean, {1,2,3}, "text"); a bare word that is
- * not one is taken as a string. */
+ * not one is taken as a string. The path is followed and set raw (no
+ * metamethod runs); it may raise a memory error, so call it inside
+ * sandbox_protected. */
 bool sandbox_apply_override(Sandbox *sb, const char *spec, Error *err);
+/* Call fn(t, ud) protected, with t the table on top of the stack (left there)
+ * and ud a light userdata; a Lua error raised inside (the memory cap, the
+ * instruction budget, any error of a library call) becomes err, prefixed with
+ * `path` as a scene file's own errors are. Returns false on such an error;
+ * fn reports its own failures through ud. */
+bool sandbox_protected(Sandbox *sb, lua_CFunction fn, void *ud, const char *path, Error *err);
 /* Call the function at stack index fn_idx with nargs numbers; the number it
  * returns goes to *out. The instruction budget still applies. */
 bool sandbox_call_number(Sandbox *sb, int fn_idx, const double *args, int nargs, double *out, Error *err);

@@ -125,6 +125,34 @@ static void default_name(const char *path, char *out, size_t n)
     snprintf(out, n, "%.*s", dot ? (int)(dot - base) : (int)strlen(base), base);
 }
 
+/* Everything of a load that reads Lua values runs inside one protected call
+ * (sandbox_protected): the overrides, the refusal of metatables and the
+ * table reader. A memory or budget error raised by the Lua API while C code
+ * reads becomes the load's error instead of reaching Lua's panic handler
+ * (SIGABRT); metatables are refused before any read could run one. */
+typedef struct ReadJob {
+    SceneLoadCtx *ctx;
+    const char *const *overrides;
+    int num_overrides;
+    Scene *scene;
+    LuaReader reader;
+    bool ok;
+} ReadJob;
+
+static int read_protected(lua_State *L)
+{
+    ReadJob *j = lua_touserdata(L, 2);
+    lua_settop(L, 1); /* the scene table */
+    Error *err = j->reader.err;
+    j->ok = true;
+    for (int i = 0; j->ok && i < j->num_overrides; i++) {
+        j->ok = sandbox_apply_override(j->ctx->sandbox, j->overrides[i], err);
+        if (!j->ok) error_prefix(err, "%s: ", j->ctx->path);
+    }
+    j->ok = j->ok && scene_read_table(&j->reader, 1, j->ctx, j->scene);
+    return 0;
+}
+
 bool scene_load(const char *path, const char *const *overrides, int num_overrides, Scene *scene, Error *err)
 {
     memset(scene, 0, sizeof *scene);
@@ -135,13 +163,15 @@ bool scene_load(const char *path, const char *const *overrides, int num_override
     dir_of(path, ctx.dir, sizeof ctx.dir);
     ctx.sandbox = sandbox_open(err);
     if (!ctx.sandbox) return false;
-    lua_State *L = sandbox_state(ctx.sandbox);
+    ReadJob job = {&ctx, overrides, num_overrides, scene, {.L = sandbox_state(ctx.sandbox), .file = path, .err = err}, false};
     bool ok = sandbox_run_file(ctx.sandbox, path, err);
-    for (int i = 0; ok && i < num_overrides; i++) {
-        ok = sandbox_apply_override(ctx.sandbox, overrides[i], err);
-        if (!ok) error_prefix(err, "%s: ", path);
+    if (ok && !sandbox_protected(ctx.sandbox, read_protected, &job, path, err)) {
+        ok = false;
+        size_t n = strnlen(err->msg, sizeof err->msg);
+        if (job.reader.path[0] && n < sizeof err->msg)
+            snprintf(err->msg + n, sizeof err->msg - n, " (while reading %s)", job.reader.path);
     }
-    ok = ok && scene_read_table(L, -1, &ctx, scene, err) && finalize(scene, err);
+    ok = ok && job.ok && finalize(scene, err);
     sandbox_close(ctx.sandbox);
     if (!ok) scene_free(scene);
     return ok;

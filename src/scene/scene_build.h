@@ -3,6 +3,7 @@
 #ifndef SL_SCENE_BUILD_H
 #define SL_SCENE_BUILD_H
 #include <lua.h>
+#include "scene/luaread.h"
 #include "scene/sandbox.h"
 #include "scene/scene.h"
 
@@ -13,7 +14,9 @@ typedef struct SceneLoadCtx {
     long long *triangles;     /* running total over the objects read so far */
 } SceneLoadCtx;
 
-bool scene_read_table(lua_State *L, int idx, const SceneLoadCtx *ctx, Scene *scene, Error *err);
+/* Read the scene table at idx through r (its key path names the value being
+ * read, also when a Lua error cuts the read short). */
+bool scene_read_table(LuaReader *r, int idx, const SceneLoadCtx *ctx, Scene *scene);
 /* One alternative file for a model, with the transform that maps it into the
  * frame of the scene's first alternative. */
 #define MODEL_MAX_CHOICES 16

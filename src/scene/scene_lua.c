@@ -352,11 +352,14 @@ static bool read_object(LuaReader *r, int idx, Object *o, int index, const Scene
 
 /* ---- top level -------------------------------------------------------- */
 
-/* Read t[key] as a list, calling fn on each element table. */
+/* Read t[key] as a list, calling fn on each element table. `alloc` gives the
+ * scene its zeroed array of n elements before any element is read, so a load
+ * cut short by a Lua error still frees what was built (scene_free). */
 typedef bool (*ElementFn)(LuaReader *r, int idx, void *elem, int index, const SceneLoadCtx *ctx);
+typedef void *(*ListAllocFn)(Scene *scene, int n);
 
-static bool read_list(LuaReader *r, int idx, const char *key, int max, size_t elem_size, void **out, int *count,
-                      ElementFn fn, const SceneLoadCtx *ctx)
+static bool read_list(LuaReader *r, int idx, const char *key, int max, Scene *scene, ListAllocFn alloc,
+                      size_t elem_size, ElementFn fn, const SceneLoadCtx *ctx)
 {
     lua_State *L = r->L;
     if (!rd_get(r, idx, key) || !lua_istable(L, -1)) {
@@ -368,16 +371,15 @@ static bool read_list(LuaReader *r, int idx, const char *key, int max, size_t el
         lua_settop(L, idx);
         return rd_fail(r, key, "has %d entries, expected 1 to %d", n, max);
     }
-    *out = calloc((size_t)n, elem_size);
-    if (!*out) return rd_fail(r, key, "needs too much memory");
-    *count = n;
+    char *elems = alloc(scene, n);
+    if (!elems) return rd_fail(r, key, "needs too much memory");
     int list = lua_gettop(L);
     size_t saved = rd_enter_key(r, key);
     bool ok = true;
     for (int i = 1; ok && i <= n; i++) {
         size_t inner = rd_enter_index(r, i);
         lua_rawgeti(L, list, i);
-        ok = lua_istable(L, -1) ? fn(r, lua_gettop(L), (char *)*out + (size_t)(i - 1) * elem_size, i, ctx)
+        ok = lua_istable(L, -1) ? fn(r, lua_gettop(L), elems + (size_t)(i - 1) * elem_size, i, ctx)
                                 : rd_fail(r, NULL, "must be a table");
         lua_settop(L, list);
         rd_leave(r, inner);
@@ -385,6 +387,20 @@ static bool read_list(LuaReader *r, int idx, const char *key, int max, size_t el
     rd_leave(r, saved);
     lua_settop(L, idx);
     return ok;
+}
+
+static void *alloc_lights(Scene *scene, int n)
+{
+    scene->lights = calloc((size_t)n, sizeof *scene->lights);
+    scene->num_lights = scene->lights ? n : 0;
+    return scene->lights;
+}
+
+static void *alloc_objects(Scene *scene, int n)
+{
+    scene->objects = calloc((size_t)n, sizeof *scene->objects);
+    scene->num_objects = scene->objects ? n : 0;
+    return scene->objects;
 }
 
 static bool light_elem(LuaReader *r, int idx, void *elem, int index, const SceneLoadCtx *ctx)
@@ -398,25 +414,23 @@ static bool object_elem(LuaReader *r, int idx, void *elem, int index, const Scen
     return read_object(r, idx, elem, index, ctx);
 }
 
-bool scene_read_table(lua_State *L, int idx, const SceneLoadCtx *ctx, Scene *scene, Error *err)
+bool scene_read_table(LuaReader *r, int idx, const SceneLoadCtx *ctx, Scene *scene)
 {
     static const char *const keys[] = {"name", "camera", "lights", "objects", NULL};
-    LuaReader r = {.L = L, .file = ctx->path, .err = err};
+    lua_State *L = r->L;
     idx = lua_absindex(L, idx);
-    if (!rd_only_keys(&r, idx, keys) || !rd_string(&r, idx, "name", scene->name, scene->name, sizeof scene->name))
+    if (!rd_refuse_metatables(r, idx) || !rd_only_keys(r, idx, keys) ||
+        !rd_string(r, idx, "name", scene->name, scene->name, sizeof scene->name))
         return false;
-    if (!rd_get(&r, idx, "camera") || !lua_istable(L, -1)) {
+    if (!rd_get(r, idx, "camera") || !lua_istable(L, -1)) {
         lua_settop(L, idx);
-        return rd_fail(&r, "camera", "must be a table");
+        return rd_fail(r, "camera", "must be a table");
     }
-    size_t saved = rd_enter_key(&r, "camera");
-    bool ok = read_camera(&r, lua_gettop(L), &scene->camera);
-    rd_leave(&r, saved);
+    size_t saved = rd_enter_key(r, "camera");
+    bool ok = read_camera(r, lua_gettop(L), &scene->camera);
+    rd_leave(r, saved);
     lua_settop(L, idx);
-    void *lights = NULL, *objects = NULL;
-    ok = ok && read_list(&r, idx, "lights", MAX_LIGHTS, sizeof(Light), &lights, &scene->num_lights, light_elem, ctx);
-    scene->lights = lights;
-    ok = ok && read_list(&r, idx, "objects", MAX_OBJECTS, sizeof(Object), &objects, &scene->num_objects, object_elem, ctx);
-    scene->objects = objects;
+    ok = ok && read_list(r, idx, "lights", MAX_LIGHTS, scene, alloc_lights, sizeof(Light), light_elem, ctx);
+    ok = ok && read_list(r, idx, "objects", MAX_OBJECTS, scene, alloc_objects, sizeof(Object), object_elem, ctx);
     return ok;
 }

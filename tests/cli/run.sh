@@ -48,6 +48,14 @@ broken face_out_of_range "$BAD/face-out-of-range.lua" "bad-index.obj:5" "out of 
 broken unreadable_file "$BAD/does-not-exist.lua" "does-not-exist.lua" "cannot open"
 broken directory_as_scene "$BAD" "bad"
 broken loop_forever "$BAD/loop-forever.lua" "loop-forever.lua" "instruction limit"
+# Hostile metatables (issue 13 §4): refused by key path before any read runs a metamethod; one set
+# while the scene is read (by an elevation function) is caught by the protected read, naming the key.
+broken metatable_index_error "$BAD/metatable-index-error.lua" "metatable-index-error.lua" "metatables"
+broken metatable_len_loop "$BAD/metatable-len-loop.lua" "lights" "metatables"
+broken metatable_tostring_key "$BAD/metatable-tostring-key.lua" "key\]" "metatables"
+broken metatable_pairs_alloc "$BAD/metatable-pairs-alloc.lua" "objects\[1\].translate" "metatables"
+broken metatable_set_while_read "$BAD/metatable-set-while-read.lua" "instruction" "objects\[2\]"
+broken tables_nested_deep "$BAD/tables-nested-deep.lua" "lights\[1\]" "deeper"
 broken os_execute "$BAD/os-execute.lua" "os-execute.lua" "os"
 if [ -e /tmp/shadowlab-pwned ]; then no sandbox_ran_command "/tmp/shadowlab-pwned exists"; else ok sandbox_ran_no_command; fi
 

@@ -42,8 +42,12 @@ for fuzzer in "$ROOT/$B"/fuzz_*; do
     if [ "$KEEP" = 1 ]; then work="$ROOT/$B/fuzz-corpus/$name"; else work="$TMP/corpus-$name"; fi
     mkdir -p "$work" "$TMP/artifacts-$name"
     log="$TMP/$name.log"
+    # A harness's dictionary (tests/fuzz/NAME.dict: tokens that reach deep paths, such as the
+    # scene's metatable machinery), when it has one.
+    dict=""
+    [ -f "$ROOT/tests/fuzz/$name.dict" ] && dict="-dict=$ROOT/tests/fuzz/$name.dict"
     # -timeout above the scene sandbox's own limits (instructions ~2 s, 20 s wall).
-    "$fuzzer" -max_total_time="$SECONDS_EACH" -timeout=30 -rss_limit_mb=4096 -detect_leaks=1 \
+    "$fuzzer" -max_total_time="$SECONDS_EACH" -timeout=30 -rss_limit_mb=4096 -detect_leaks=1 $dict \
         -artifact_prefix="$TMP/artifacts-$name/" -print_final_stats=1 "$work" "$seeds" $(more_seeds "$name") >"$log" 2>&1
     status=$?
     runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
