@@ -79,8 +79,9 @@ function sweep.rng(seed)
   end
 end
 
--- A range is {min, max [, "int" | "log" | "int log"]}: ints are rounded, "log"
--- spreads samples evenly in log(value) (map sizes, radii over decades).
+-- A range is {min, max [, "int" | "log" | "int log"]}: ints are drawn from the
+-- integers ceil(min) .. floor(max), "log" spreads samples evenly in log(value)
+-- (map sizes, radii over decades).
 local function check_range(name, r)
   if type(r) ~= "table" or type(r[1]) ~= "number" or type(r[2]) ~= "number" or r[1] > r[2] then
     error(string.format("sweep: range of %s must be {min, max [, 'int'|'log'|'int log']} with min <= max", name), 4)
@@ -89,16 +90,23 @@ local function check_range(name, r)
   if flags:find("log") and r[1] <= 0 then
     error(string.format("sweep: log range of %s needs min > 0", name), 4)
   end
+  if flags:find("int") and math.ceil(r[1]) > math.floor(r[2]) then
+    error(string.format("sweep: int range of %s holds no integer", name), 4)
+  end
   return flags:find("int") ~= nil, flags:find("log") ~= nil
 end
 
+-- The value at u in [0, 1) on a range. An integer k of an int range owns the
+-- cell [k, k + 1) of the continuous range [lo, hi + 1), uniform or log-uniform,
+-- and u is mapped onto that range and floored: every integer gets the weight
+-- of its cell (all equal without "log"), and a stratum of u that spans one cell
+-- lands in it exactly (rounding to the nearest instead gave the endpoints half
+-- a cell, so a Latin sweep of n strata over n integers could miss one).
 local function place(r, is_int, is_log, u)
   local lo, hi = r[1], r[2]
+  if is_int then lo, hi = math.ceil(lo), math.floor(hi) + 1 end
   local v = is_log and math.exp(math.log(lo) + u * (math.log(hi) - math.log(lo))) or lo + u * (hi - lo)
-  if is_int then
-    v = math.floor(v + 0.5)
-    v = math.tointeger(math.max(math.ceil(lo), math.min(math.floor(hi), v)))
-  end
+  if is_int then v = math.tointeger(math.min(hi - 1, math.max(lo, math.floor(v)))) end
   return v
 end
 
