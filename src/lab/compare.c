@@ -69,13 +69,17 @@ uint64_t lab_config_key(const Lab *lab, const Technique *t, const double *params
 {
     Hasher h;
     hash_init(&h);
-    hash_str(&h, "shadowlab configuration 1");
+    hash_str(&h, "shadowlab configuration 2");
     hash_u64(&h, lab_scene(lab)->hash);
     hash_u64(&h, (uint64_t)light_index);
     hash_str(&h, t->name);
     for (int i = 0; i < t->num_params; i++) {
-        hash_str(&h, t->params[i].name);
-        hash_f64(&h, params[i]);
+        const ParamDesc *p = &t->params[i];
+        hash_str(&h, p->name);
+        /* An enum by its choice's name, not its index: reordering or inserting
+         * a choice must not make a recorded row answer for another one. */
+        if (p->type == PARAM_ENUM) hash_str(&h, p->choices[(int)params[i]]);
+        else hash_f64(&h, params[i]);
     }
     return hash_final(&h);
 }
