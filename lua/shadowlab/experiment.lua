@@ -118,6 +118,7 @@ experiment options:
   --out DIR        results folder (default reports/NAME)
   --resume         continue the results in --out, skipping configurations already recorded
   --fresh          discard the results in --out and start again
+  --mixed-builds   let --resume add rows of this build (commit, CPU, threads) beside rows of another
   --shard I/N      run only configurations whose index modulo N is I (0 <= I < N), into their own files
   --threads N      worker threads
   --repeats N      timed evaluations per configuration (median and minimum recorded)
@@ -168,6 +169,7 @@ function experiment.parse_args(argv, extra)
     if a == "--out" then o.out = argv[i + 1] or usage_error("--out expects a folder"); i = i + 1
     elseif a == "--resume" then o.resume = true
     elseif a == "--fresh" then o.fresh = true
+    elseif a == "--mixed-builds" then o.mixed_builds = true
     elseif a == "--no-images" then o.images = false
     elseif a == "--quiet" then o.quiet = true
     elseif a == "--set" or a == "-s" then
@@ -287,8 +289,13 @@ function Experiment:open_results(o, configs)
   end
   sl.mkdir(o.out)
   local settings = self:settings()
+  -- The fingerprint covers the configurations themselves (their keys hash the
+  -- scene's content, the technique and every parameter): a grid edited under
+  -- the same name and settings, or a scene edited since, is another experiment.
+  local keys = {}
+  for i, c in ipairs(configs) do keys[i] = c.key end
   local header = { shadowlab_results = 1, name = self.name, settings = settings,
-                   fingerprint = sl.hash(json.encode({ name = self.name, settings = settings })),
+                   fingerprint = sl.hash(json.encode({ name = self.name, settings = settings, keys = keys })),
                    shard = o.shard, configurations = #configs, columns = self:columns() }
   return records.open(jsonl, csv, header, function(row) return row.status == "ok" end), header
 end
@@ -351,6 +358,32 @@ local function progress(o, n, total, config, row)
                                 row.record.resource_cache))
 end
 
+-- Rows measured by another build (commit, CPU, threads: records.build_of)
+-- are not mixed with this run's: --resume that would compute new rows beside
+-- them is refused unless --mixed-builds, and then results.csv's commit, cpu
+-- and threads columns and the report's machine line tell them apart. A
+-- resume that computes nothing (writing the report of merged shards) mixes
+-- nothing and passes.
+local function refuse_mixed_builds(o, writer, mine)
+  if o.mixed_builds or #writer.rows == 0 then return end
+  local pending = 0
+  for _, c in ipairs(mine) do
+    if not writer.done[c.key] then pending = pending + 1 end
+  end
+  if pending == 0 then return end
+  local here = sl.machine()
+  here.host = nil
+  local mine_text = records.build_text(here)
+  for _, b in ipairs(records.builds(writer.rows)) do
+    if b.text ~= mine_text then
+      error(string.format("%s holds %d rows measured with %s; this run is %s: %d new rows would be mixed with " ..
+                          "them. Use --fresh to start again, another --out, or --mixed-builds to keep both " ..
+                          "(told apart by results.csv's commit, cpu and threads columns)", writer.path, b.rows,
+                          b.text, mine_text, pending), 0)
+    end
+  end
+end
+
 -- Run the experiment with the script's arguments (arg, or parse_args's
 -- result). Returns a result table:
 -- rows (this output's rows in configuration order), out, sharded, computed,
@@ -384,6 +417,7 @@ function Experiment:run(argv)
   for _, c in ipairs(configs) do
     if c.index % o.shard.count == o.shard.index then mine[#mine + 1] = c end
   end
+  refuse_mixed_builds(o, writer, mine)
   local last_use, last_of_technique = {}, {}
   for i, c in ipairs(mine) do
     last_use[c.variant] = i

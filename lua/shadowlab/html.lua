@@ -4,6 +4,7 @@
 -- checks on load that every image arrived and says so at the top of the page
 -- (the browser test reads that line).
 local sl = package.loaded.shadowlab or require "shadowlab"
+local records = require "shadowlab.records"
 
 local html = {}
 
@@ -115,12 +116,15 @@ local function image_grid(entry, doc, out)
   out[#out + 1] = "</div>"
 end
 
+-- Every build the rows were measured with (one, unless --mixed-builds), with
+-- its row count when there are several.
 local function machine_text(doc)
-  local r = doc.ok_rows[1]
-  if not r then return "no successful configuration" end
-  local m = r.record.machine
-  return string.format("%s (%s, %s), %d threads, commit %s", esc(m.cpu), esc(m.host), esc(m.arch),
-                       m.threads, esc(m.commit))
+  local builds = records.builds(doc.ok_rows)
+  if #builds == 0 then return "no successful configuration" end
+  if #builds == 1 then return esc(builds[1].text) end
+  local parts = {}
+  for _, b in ipairs(builds) do parts[#parts + 1] = string.format("%s (%d rows)", esc(b.text), b.rows) end
+  return "<b>mixed builds</b>: " .. table.concat(parts, "; ")
 end
 
 local definitions = [[

@@ -1,8 +1,11 @@
 -- merge.lua -- `shadowlab merge [-o OUT] [--force] DIR...`: the results of a
 -- sweep's shards (records*.jsonl in each DIR) merged into OUT/records.jsonl
 -- and OUT/results.csv, with the shards' images copied into OUT/images.
--- Refuses files of different experiments (name or fingerprint), a shard
--- given twice, and any configuration recorded twice. Afterwards
+-- Refuses files of different experiments (name or fingerprint, which covers
+-- the configuration list), a shard given twice, shards of different splits
+-- (0/2 with 1/3), missing shards (unless --partial), any configuration
+-- recorded twice, and rows of different builds (commit, CPU, threads;
+-- unless --mixed-builds). Afterwards
 -- `shadowlab run SCRIPT --resume --out OUT` finds everything recorded and
 -- writes the report.
 local sl = package.loaded.shadowlab or require "shadowlab"
@@ -11,8 +14,10 @@ local records = require "shadowlab.records"
 
 local merge = {}
 
-local usage = "usage: shadowlab merge [-o OUT] [--force] DIR...\n" ..
-              "  merges the records*.jsonl of the shard folders DIR... into OUT (default: the first DIR)\n"
+local usage = "usage: shadowlab merge [-o OUT] [--force] [--partial] [--mixed-builds] DIR...\n" ..
+              "  merges the records*.jsonl of the shard folders DIR... into OUT (default: the first DIR)\n" ..
+              "  --partial: accept a set of shards with some missing (their configurations stay missing)\n" ..
+              "  --mixed-builds: accept rows of different commits, CPUs or thread counts\n"
 
 -- A refusal exits 1; a usage error (bad option, missing value or DIR) exits 2.
 local function fail(msg) error({ message = msg, status = 1 }, 0) end
@@ -27,6 +32,8 @@ local function parse(argv)
       if not o.out or o.out:sub(1, 1) == "-" then usage_fail(a .. " expects a folder") end
       i = i + 1
     elseif a == "--force" then o.force = true
+    elseif a == "--partial" then o.partial = true
+    elseif a == "--mixed-builds" then o.mixed_builds = true
     elseif a == "--help" or a == "-h" then o.help = true
     elseif a:sub(1, 1) == "-" then usage_fail("unknown option '" .. a .. "'")
     else o.dirs[#o.dirs + 1] = (a:gsub("/+$", "")) end
@@ -80,6 +87,39 @@ local function read_all(files)
     inputs[#inputs + 1] = { path = path, header = header, rows = rows, shard = shard }
   end
   return inputs, first.header
+end
+
+-- Every input splits the configurations the same way (--shard I/N with one
+-- N), and every I of 0 .. N-1 is there unless --partial.
+local function check_shard_set(o, inputs)
+  local count = inputs[1].shard.count
+  for _, input in ipairs(inputs) do
+    if input.shard.count ~= count then
+      fail(string.format("%s is shard %d/%d but %s is shard %d/%d: shards of different splits do not cover " ..
+                         "the configurations once", input.path, input.shard.index, input.shard.count,
+                         inputs[1].path, inputs[1].shard.index, count))
+    end
+  end
+  local have, missing = {}, {}
+  for _, input in ipairs(inputs) do have[input.shard.index] = true end
+  for i = 0, count - 1 do
+    if not have[i] then missing[#missing + 1] = i .. "/" .. count end
+  end
+  if #missing > 0 and not o.partial then
+    fail(string.format("shard%s %s of %d missing: pass --partial to merge without %s", #missing > 1 and "s" or "",
+                       table.concat(missing, ", "), count, #missing > 1 and "them" or "it"))
+  end
+end
+
+-- All rows come from one build, unless --mixed-builds.
+local function check_builds(o, rows)
+  local builds = records.builds(rows)
+  if #builds > 1 and not o.mixed_builds then
+    local parts = {}
+    for _, b in ipairs(builds) do parts[#parts + 1] = string.format("%d rows with %s", b.rows, b.text) end
+    fail("rows of different builds: " .. table.concat(parts, "; ") .. ": pass --mixed-builds to merge them " ..
+         "(results.csv's commit, cpu and threads columns tell them apart)")
+  end
 end
 
 local function merged_rows(inputs)
@@ -137,7 +177,9 @@ local function run(argv)
     if not o.force then fail(out_path .. " exists: pass --force to replace it, or choose another -o") end
   end
   local inputs, header = read_all(input_files(o))
+  check_shard_set(o, inputs)
   local rows = merged_rows(inputs)
+  check_builds(o, rows)
   local out_header = {}
   for k, v in pairs(header) do out_header[k] = v end
   out_header.shard = { index = 0, count = 1 }

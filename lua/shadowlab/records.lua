@@ -102,8 +102,41 @@ records.standard_columns = {
   { "false_lit", record_field("metrics", "false_lit") },
   { "threads", record_field("machine", "threads") },
   { "host", record_field("machine", "host") },
+  { "cpu", record_field("machine", "cpu") },
+  { "commit", record_field("machine", "commit") },
   { "error", function(r) return r.error end },
 }
+
+-- The build a row was measured with: commit, CPU model, architecture and
+-- worker threads (not the host name: the nodes of one cluster partition are
+-- the same machine for timing). nil for a row without a record (a failure).
+function records.build_of(row)
+  local m = row.record and row.record.machine
+  if not m then return nil end
+  return { commit = m.commit, cpu = m.cpu, arch = m.arch, threads = m.threads }
+end
+
+function records.build_text(b)
+  return string.format("commit %s, %s (%s), %s threads", tostring(b.commit), tostring(b.cpu), tostring(b.arch),
+                       tostring(b.threads))
+end
+
+-- The distinct builds of rows, in first-seen order, each with its row count.
+function records.builds(rows)
+  local list, by_text = {}, {}
+  for _, row in ipairs(rows) do
+    local b = records.build_of(row)
+    if b then
+      local t = records.build_text(b)
+      if not by_text[t] then
+        by_text[t] = { build = b, text = t, rows = 0 }
+        list[#list + 1] = by_text[t]
+      end
+      by_text[t].rows = by_text[t].rows + 1
+    end
+  end
+  return list
+end
 
 local standard_getter = {}
 for _, c in ipairs(records.standard_columns) do standard_getter[c[1]] = c[2] end

@@ -10,8 +10,10 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/utsname.h>
 #include <unistd.h>
 #include "core/hash.h"
+#include "core/machine.h"
 #include "core/timer.h"
 #include "lua/sl_lua.h"
 #include "resources/refcache.h"
@@ -101,12 +103,36 @@ static int sl_default_cache(lua_State *L)
     return 1;
 }
 
+/* sl.machine(): what this process would record of its build and machine,
+ * {commit, cpu, arch, host, threads}, the fields a record's "machine" holds:
+ * experiments compare it with recorded rows before mixing new rows in. */
+static int sl_machine(lua_State *L)
+{
+    char cpu[256];
+    struct utsname u;
+    machine_cpu_model(cpu, sizeof cpu);
+    lua_createtable(L, 0, 5);
+    lua_pushstring(L, SHADOWLAB_COMMIT);
+    lua_setfield(L, -2, "commit");
+    lua_pushstring(L, cpu);
+    lua_setfield(L, -2, "cpu");
+    if (uname(&u) == 0) {
+        lua_pushstring(L, u.machine);
+        lua_setfield(L, -2, "arch");
+        lua_pushstring(L, u.nodename);
+        lua_setfield(L, -2, "host");
+    }
+    lua_pushinteger(L, omp_get_max_threads());
+    lua_setfield(L, -2, "threads");
+    return 1;
+}
+
 int luaopen_shadowlab(lua_State *L)
 {
     static const luaL_Reg funcs[] = {
         {"techniques", sl_techniques}, {"technique", sl_technique}, {"params", sl_params},
         {"open", sl_lab_open},         {"threads", sl_threads},     {"hash", sl_hash},
-        {"now", sl_now},               {"default_cache", sl_default_cache},
+        {"now", sl_now},               {"default_cache", sl_default_cache}, {"machine", sl_machine},
         {NULL, NULL},
     };
     find_root();

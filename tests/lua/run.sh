@@ -74,7 +74,7 @@ expect script_result_is_the_exit_status 3 -- "$SL" run tests/lua/bad/returns.lua
 for kind in string float big; do
     expect "script_returning_a_${kind}_fails" 1 "not an exit status" -- "$SL" run tests/lua/bad/returns.lua "$kind"
 done
-expect run_help_lists_every_experiment_option 0 --out --resume --fresh --shard --threads --repeats --warmup \
+expect run_help_lists_every_experiment_option 0 --out --resume --fresh --mixed-builds --shard --threads --repeats --warmup \
     --samples --set --no-images --quiet -- "$SL" run --help
 expect experiment_unknown_argument 2 "unknown argument '--frob'" -- "$SL" run "$SWEEP" --frob
 expect experiment_bad_shard 2 "--shard expects I/N" -- "$SL" run "$SWEEP" --shard 2/2
@@ -147,13 +147,48 @@ expect merge_o_needs_a_folder 2 "-o expects a folder" "usage: shadowlab merge" -
 expect merge_o_then_an_option 2 "-o expects a folder" -- "$SL" merge -o --force "$FULL"
 expect merge_needs_a_dir 2 "no DIR given" -- "$SL" merge -o "$TMP/nodir"
 expect merge_missing_dir 1 "$TMP/absent" -- "$SL" merge -o "$TMP/m" "$TMP/absent"
-expect merge_refuses_duplicates 1 "refusing duplicates" -- "$SL" merge -o "$TMP/dup" "$FULL" "$PAR/shards/0"
+expect merge_refuses_a_whole_run_with_a_shard 1 "different splits" -- \
+    "$SL" merge -o "$TMP/dup" "$FULL" "$PAR/shards/0"
+mkdir -p "$TMP/dup1"
+sed '1s/"index":0/"index":1/' "$PAR/shards/0/records.shard-0-of-2.jsonl" >"$TMP/dup1/records.shard-1-of-2.jsonl"
+expect merge_refuses_duplicates 1 "refusing duplicates" -- "$SL" merge -o "$TMP/dup" "$PAR/shards/0" "$TMP/dup1"
 "$SL" run "$SWEEP" --out "$TMP/other" --shard 0/2 --samples 8 --quiet --no-images >/dev/null 2>&1
 expect merge_refuses_mismatched_experiments 1 "refusing to merge different experiments" -- \
     "$SL" merge -o "$TMP/mix" "$TMP/other" "$PAR/shards/1"
 expect merge_refuses_to_overwrite 1 "--force" -- "$SL" merge -o "$PAR" "$PAR/shards/0" "$PAR/shards/1"
 expect resume_refuses_another_experiment 1 "fingerprint" "--fresh" -- \
     "$SL" run "$SWEEP" --out "$FULL" --resume --samples 8 --quiet
+
+# ---- records that cannot mix runs: the fingerprint covers the configuration list, merge checks the
+# shard set and the builds, --resume does not add rows of this build beside another's
+sed 's/offset_scale = { 0.5, 1, 4 }/offset_scale = { 0.5, 1, 8 }/' "$SWEEP" >"$TMP/other-grid.lua"
+"$SL" run "$TMP/other-grid.lua" --out "$TMP/grid2" --shard 1/2 --threads 1 --quiet --no-images >/dev/null 2>&1
+expect merge_refuses_another_grid_of_the_same_name 1 "refusing to merge different experiments" -- \
+    "$SL" merge -o "$TMP/grids" "$PAR/shards/0" "$TMP/grid2"
+"$SL" run "$SWEEP" --out "$TMP/third" --shard 1/3 --threads 1 --quiet --no-images >/dev/null 2>&1
+expect merge_refuses_shards_of_different_splits 1 "different splits" "1/3" -- \
+    "$SL" merge -o "$TMP/splits" "$PAR/shards/0" "$TMP/third"
+expect merge_refuses_a_missing_shard 1 "shard 1/2 of 2 missing" "--partial" -- \
+    "$SL" merge -o "$TMP/half" "$PAR/shards/0"
+expect merge_partial_on_request 0 "3 of 6 configurations" "3 missing" -- \
+    "$SL" merge --partial -o "$TMP/half" "$PAR/shards/0"
+mkdir -p "$TMP/rebuilt"
+sed 's/"commit":"[^"]*"/"commit":"0123456789ab"/g' "$PAR/shards/1/records.shard-1-of-2.jsonl" \
+    >"$TMP/rebuilt/records.shard-1-of-2.jsonl"
+expect merge_refuses_rows_of_another_build 1 "rows of different builds" "0123456789ab" "--mixed-builds" -- \
+    "$SL" merge -o "$TMP/builds" "$PAR/shards/0" "$TMP/rebuilt"
+expect merge_mixed_builds_on_request 0 "6 of 6 configurations" -- \
+    "$SL" merge --mixed-builds -o "$TMP/builds" "$PAR/shards/0" "$TMP/rebuilt"
+grep -q "0123456789ab" "$TMP/builds/results.csv" && ok merged_csv_has_a_commit_column ||
+    no merged_csv_has_a_commit_column "no commit in results.csv"
+mkdir -p "$TMP/stale"
+head -n 4 "$FULL/records.jsonl" | sed 's/"commit":"[^"]*"/"commit":"0123456789ab"/g' >"$TMP/stale/records.jsonl"
+expect resume_refuses_to_mix_builds 1 "3 rows measured with commit 0123456789ab" "--mixed-builds" -- \
+    "$SL" run "$SWEEP" --out "$TMP/stale" --resume --quiet --no-images
+expect resume_mixed_builds_on_request 0 "3 computed, 3 already recorded" -- \
+    "$SL" run "$SWEEP" --out "$TMP/stale" --resume --mixed-builds --no-images
+grep -q "mixed builds" "$TMP/stale/index.html" && ok report_names_mixed_builds ||
+    no report_names_mixed_builds "index.html has no 'mixed builds'"
 
 # ---- the shipped experiments at tiny settings (the default runs are the README's)
 TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeats 1 --warmup 0 --no-images"
