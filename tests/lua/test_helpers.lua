@@ -300,6 +300,61 @@ test("autotune_returns_the_best_feasible_point_it_evaluated", function()
   lab:close()
 end)
 
+test("autotune_defaults_to_the_main_parameter_and_the_map_size", function()
+  local function names(t) return table.concat(autotune.default_params(sl.technique(t)), " ") end
+  assert(names("pcf") == "K map_size", "pcf: " .. names("pcf"))
+  assert(names("sm") == "map_size", "sm: " .. names("sm"))
+  assert(names("hard") == "offset_scale", "hard: " .. names("hard"))
+end)
+
+test("autotune_skips_and_reports_refused_points", function()
+  -- explicit splits with split_1 given: only cascades = 2 is accepted, every other
+  -- value is refused by the engine, and the search goes on past each refusal
+  local lab = sl.open("scenes/sphere-on-plane.lua", small)
+  local r = autotune.run{ lab = lab, technique = "pcf", params = { "cascades" }, budget_s = 1e3, evaluations = 5,
+                          initial = 3, samples = 4, repeats = 1, warmup = 0, cache = false,
+                          fixed = { split_scheme = "explicit", split_1 = 3, map_size = 64 } }
+  assert(#r.refused >= 1, "some cascade counts are refused")
+  for _, p in ipairs(r.refused) do
+    assert(p.params.cascades ~= 2 and p.message:find("split", 1, true), "refused: " .. tostring(p.message))
+  end
+  for _, p in ipairs(r.history) do assert(p.params.cascades == 2, "only cascades = 2 runs") end
+  assert(#r.history + #r.refused <= 5, "refusals count as evaluations")
+  lab:close()
+end)
+
+test("autotune_searches_a_zero_based_range_over_decades_in_log", function()
+  -- hard's offset_scale in [0, 1e4], default 1: the Latin start lies in [1e-3, 1e4] spread in
+  -- log (linear strata of 1e4 / 3 would put every start above 1000)
+  local lab = sl.open("scenes/sphere-on-plane.lua", small)
+  local r = autotune.run{ lab = lab, technique = "hard", budget_s = 1e3, evaluations = 4, initial = 3, samples = 4,
+                          repeats = 1, warmup = 0, cache = false }
+  local below = 0
+  for _, p in ipairs(r.history) do
+    if p.params.offset_scale < 100 then below = below + 1 end
+  end
+  assert(below >= 2, "points below 100 of 4: " .. below)
+  lab:close()
+end)
+
+test("autotune_measures_a_point_just_over_the_budget_twice", function()
+  -- a stand-in lab whose first measurement of each point is slow: 1.5x the budget is measured
+  -- again (and kept when faster), 5x is not
+  local calls = {}
+  local fake = { compare = function(_, opts)
+    local id = json.encode(opts.params)
+    calls[id] = (calls[id] or 0) + 1
+    local t = opts.params.offset_scale == 1 and (calls[id] == 1 and 0.015 or 0.008) or 0.05
+    return { record = function() return { metrics = { all = { rmse = 0.1 } }, timings_s = { frame = t } } end }
+  end }
+  local r = autotune.run{ lab = fake, technique = "hard", budget_s = 0.01, evaluations = 3, initial = 2 }
+  local default = r.history[1]
+  assert(default.params.offset_scale == 1 and default.measured == 2 and default.time == 0.008 and default.feasible,
+         "the default point is measured twice and fits")
+  for i = 2, #r.history do assert(not r.history[i].measured and not r.history[i].feasible) end
+  assert(r.best == default)
+end)
+
 ---------------------------------------------------------------- plots
 
 local function fake_row(scene, samples, noise)
