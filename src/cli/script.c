@@ -1,8 +1,8 @@
 /* script.c -- `shadowlab run [--threads N] SCRIPT.lua [ARGS...]`: a Lua 5.4
  * interpreter with the shadowlab module loaded (src/lua/), the project's lua/
  * folder on package.path, and `arg` set as lua5.4 sets it (arg[0] the
- * script, arg[1..] its arguments). A Lua error exits 1 with its message and
- * a traceback; the script's result is its exit status (nil: 0). The same
+ * script, arg[1..] its arguments). A Lua error exits 1 with its message (and
+ * a traceback when it is the lab's own, see internal_error); the script's result is its exit status (nil: 0). The same
  * interpreter runs the Lua side of `merge`. */
 #include <lauxlib.h>
 #include <limits.h>
@@ -27,11 +27,31 @@ static void set_project_root(void)
     if (realpath(root, exe)) sl_lua_set_root(exe);
 }
 
+/* Whether an error message is the lab's own: it starts with a position in the
+ * project's Lua helpers (lua/shadowlab/) or in a chunk that is not a file.
+ * Errors at the user's line (the helpers raise a user's mistakes, such as a
+ * parameter out of range, at the caller's level) and errors without a
+ * position (a resume conflict, a refused override) are the user's. */
+static bool internal_error(const char *msg)
+{
+    const char *colon = strchr(msg, ':');
+    if (!colon || colon[1] < '0' || colon[1] > '9') return false; /* no "file:line:" position */
+    size_t file_len = (size_t)(colon - msg);
+    if (msg[0] == '[') return true;                               /* [C], [string "..."] */
+    const char *helpers = "lua/shadowlab/";
+    for (const char *p = msg; p + strlen(helpers) <= colon; p++)
+        if (strncmp(p, helpers, strlen(helpers)) == 0) return true;
+    return file_len == 0;
+}
+
+/* The message handler: the lab's own errors get a traceback (a bug to report);
+ * a user's error prints as its message alone, pointing at their line. */
 static int traceback(lua_State *L)
 {
     const char *msg = lua_tostring(L, 1);
     if (!msg) msg = lua_pushfstring(L, "(error object is a %s value)", luaL_typename(L, 1));
-    luaL_traceback(L, L, msg, 1);
+    if (internal_error(msg)) luaL_traceback(L, L, msg, 1);
+    else lua_pushstring(L, msg);
     return 1;
 }
 

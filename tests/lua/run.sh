@@ -68,6 +68,13 @@ expect run_syntax_error 1 "syntax.lua:2:" -- "$SL" run tests/lua/bad/syntax.lua
 expect bad_param_refused_before_running 1 "offset_scale" "[0, 10000]" -- \
     "$SL" run tests/lua/bad/bad-param.lua --out "$TMP/bad"
 if [ -e "$TMP/bad" ]; then no bad_param_writes_nothing "$TMP/bad exists"; else ok bad_param_writes_nothing; fi
+# A user's mistake prints its message at the user's line, without a Lua stack trace; the lab's own
+# errors keep theirs.
+"$SL" run tests/lua/bad/bad-param.lua --out "$TMP/bad" >"$TMP/err" 2>&1
+if grep -q "bad-param.lua:6:" "$TMP/err" && ! grep -q "stack traceback" "$TMP/err"; then
+    ok user_error_has_no_traceback
+else no user_error_has_no_traceback "traceback or no line"; fi
+expect internal_error_keeps_its_traceback 1 "json.lua" "stack traceback" -- "$SL" run tests/lua/bad/internal-error.lua
 expect unknown_param_names_the_known_ones 1 "unknown parameter 'ofset_scale'" "offset_scale" -- \
     "$SL" run tests/lua/bad/unknown-param.lua
 expect script_result_is_the_exit_status 3 -- "$SL" run tests/lua/bad/returns.lua 3
