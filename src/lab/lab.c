@@ -14,7 +14,21 @@ struct Lab {
     ResourceManager *rm;
     bool owns_rm;
     double load_s;
+    char **overrides; /* the scene overrides as given ("lights[1].radius=0.1"), for records */
+    int num_overrides;
 };
+
+static bool keep_overrides(Lab *lab, const char *const *overrides, int n)
+{
+    lab->overrides = n > 0 ? calloc((size_t)n, sizeof *lab->overrides) : NULL;
+    if (n > 0 && !lab->overrides) return false;
+    for (int i = 0; i < n; i++) {
+        lab->overrides[i] = strdup(overrides[i]);
+        if (!lab->overrides[i]) return false;
+        lab->num_overrides = i + 1;
+    }
+    return true;
+}
 
 Lab *lab_open_shared(const char *scene_path, const char *const *overrides, int num_overrides, ResourceManager *rm,
                      Error *err)
@@ -29,7 +43,7 @@ Lab *lab_open_shared(const char *scene_path, const char *const *overrides, int n
     lab->load_s = timer_now_s() - t0;
     lab->owns_rm = rm == NULL;
     lab->rm = rm ? rm : rm_create();
-    if (!lab->rm) {
+    if (!lab->rm || !keep_overrides(lab, overrides, num_overrides)) {
         lab_close(lab);
         error_set(err, "out of memory");
         return NULL;
@@ -47,12 +61,20 @@ void lab_close(Lab *lab)
     if (!lab) return;
     if (lab->owns_rm) rm_destroy(lab->rm);
     scene_free(&lab->scene);
+    for (int i = 0; i < lab->num_overrides; i++) free(lab->overrides[i]);
+    free(lab->overrides);
     free(lab);
 }
 
 const Scene *lab_scene(const Lab *lab) { return &lab->scene; }
 ResourceManager *lab_resources(Lab *lab) { return lab->rm; }
 double lab_scene_load_seconds(const Lab *lab) { return lab->load_s; }
+
+int lab_overrides(const Lab *lab, const char *const **overrides)
+{
+    *overrides = (const char *const *)lab->overrides;
+    return lab->num_overrides;
+}
 
 bool lab_light_index(const Lab *lab, int number, int *index, Error *err)
 {

@@ -20,6 +20,8 @@ Lab *lab_open_shared(const char *scene_path, const char *const *overrides, int n
                      Error *err);
 void lab_close(Lab *lab);
 const Scene *lab_scene(const Lab *lab);
+/* The scene overrides the Lab was opened with, as given ("key.path=value"). */
+int lab_overrides(const Lab *lab, const char *const **overrides);
 ResourceManager *lab_resources(Lab *lab);
 double lab_scene_load_seconds(const Lab *lab);
 /* Check a 1-based light number against the scene; returns the 0-based index. */

@@ -49,6 +49,11 @@ static void write_scene(JsonWriter *w, const RunReport *r)
     json_array_begin(w, "models");
     for (int i = 0; i < sc->num_objects; i++) json_string(w, NULL, sc->objects[i].source);
     json_array_end(w);
+    const char *const *overrides;
+    int num_overrides = lab_overrides(r->lab, &overrides);
+    json_array_begin(w, "overrides");
+    for (int i = 0; i < num_overrides; i++) json_string(w, NULL, overrides[i]);
+    json_array_end(w);
     json_object_end(w);
 }
 

@@ -77,6 +77,18 @@ static void append(char *out, size_t n, size_t *used, const char *fmt, ...)
     va_end(ap);
 }
 
+/* A double in the fewest significant digits (15 to 17) that read back as the
+ * same value, so an override of 0.1 is recorded as 0.1, not 0.10000000000000001. */
+static void append_double(char *out, size_t n, size_t *used, double v)
+{
+    char text[32];
+    for (int digits = 15; digits <= 17; digits++) {
+        snprintf(text, sizeof text, "%.*g", digits, v);
+        if (strtod(text, NULL) == v) break;
+    }
+    append(out, n, used, "%s", text);
+}
+
 /* Append an override value as the Lua expression the scene sandbox
  * evaluates: numbers, booleans, quoted strings, arrays of these. */
 static void override_text(lua_State *L, int idx, char *out, size_t n, size_t *used)
@@ -85,7 +97,7 @@ static void override_text(lua_State *L, int idx, char *out, size_t n, size_t *us
     switch (lua_type(L, idx)) {
     case LUA_TNUMBER:
         if (lua_isinteger(L, idx)) append(out, n, used, "%lld", (long long)lua_tointeger(L, idx));
-        else append(out, n, used, "%.17g", lua_tonumber(L, idx));
+        else append_double(out, n, used, lua_tonumber(L, idx));
         break;
     case LUA_TBOOLEAN: append(out, n, used, "%s", lua_toboolean(L, idx) ? "true" : "false"); break;
     case LUA_TSTRING:

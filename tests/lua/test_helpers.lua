@@ -355,6 +355,15 @@ test("autotune_measures_a_point_just_over_the_budget_twice", function()
   assert(r.best == default)
 end)
 
+test("records_carry_the_scene_overrides_as_written", function()
+  local lab = sl.open("scenes/sphere-on-plane.lua", { ["lights[1].radius"] = 0.1, ["camera.width"] = 16,
+                                                       ["camera.height"] = 12 })
+  local rec = lab:compare{ technique = "hard", samples = 4 }:record()
+  lab:close()
+  local text = table.concat(rec.scene.overrides, " ")
+  assert(text == "camera.height=12 camera.width=16 lights[1].radius=0.1", "overrides: " .. text)
+end)
+
 ---------------------------------------------------------------- plots
 
 local function fake_row(scene, samples, noise)
