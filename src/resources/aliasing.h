@@ -101,11 +101,16 @@ typedef struct AliasingMap {
 const AliasingMap *res_aliasing(ResourceManager *rm, const Scene *scene, int light_index, const ShadowMap *map,
                                 Error *err);
 
-/* Lloyd et al. 2006's measure over the view frustum, not the samples:
- * perspective aliasing only (each point's normal bisects the directions to
- * the eye and to the light, so cos(alpha) = cos(beta)), at an nx x ny grid
- * of image positions times nz view depths (log spaced over near..far),
- * inside the scene's bounds. */
+/* Lloyd et al. 2006's measure over the intersection body B (the view
+ * frustum inside the scene's bounds), not the samples: perspective
+ * aliasing only (each point's normal bisects the directions to the eye and
+ * to the light, so cos(alpha) = cos(beta)). Each map's maximum lies on the
+ * boundary of its region, so the probes include it: nx x ny rays at image
+ * positions -1..1 (edges and corners included), nz view depths along each,
+ * log spaced from its entry into B to its exit (both included), each map
+ * change along a ray bisected; then a climb from each map's highest m_s
+ * and m_t raises the maxima (s->storage converges from below in the
+ * points; counts and means are the probes'). */
 void aliasing_frustum(const LightView *lv, const Scene *scene, const Light *light, int nx, int ny, int nz,
                       AliasingSummary *out);
 

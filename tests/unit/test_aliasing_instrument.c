@@ -4,10 +4,14 @@
  * uniform map's error (and its convergence in the number of points where no
  * closed form is at hand), and the instrument's m on a LogPSM map against
  * the map that is actually ray cast per texel (logmap.c), with a round trip
- * of the logarithmic warp over the frustum. Each runs in well under a
+ * of the logarithmic warp over the frustum; and the report's names for the
+ * two storages. Each runs in well under a
  * second (maps of 256^2, scenes of 320 x 240 pixels that are not rendered). */
+#include <stdlib.h>
 #include <string.h>
+#include "core/fsutil.h"
 #include "fixtures.h"
+#include "lab/aliasing_report.h"
 #include "resources/aliasing.h"
 #include "resources/warp.h"
 #include "techniques/smap.h"
@@ -245,4 +249,36 @@ TEST(test_aliasing_logpsm_warp_round_trip)
         CHECK(base_err < 1e-12);
         lab_close(lab);
     }
+}
+
+/* The samples' storage includes projection aliasing, so the report names it
+ * total_aliasing_storage and keeps storage_factor for Lloyd's measure over
+ * the frustum (aliasing.json: one of each, in its own summary). */
+TEST(test_aliasing_report_names_each_storage_for_what_it_is)
+{
+    Lab *lab = open_scene("scenes/overhead-plane.lua", "camera.width=64");
+    CHECK(lab);
+    const char *a[] = {"fit=body", "map_size=256", "projection=lispsm"};
+    const ShadowMap *m = map_with(lab, a, 3);
+    Error err;
+    const Scene *sc = lab_scene(lab);
+    const AliasingMap *an = m ? res_aliasing(lab_resources(lab), sc, 0, m, &err) : NULL;
+    CHECK(an);
+    AliasingSummary fr;
+    aliasing_frustum(&m->view, sc, &sc->lights[0], 6, 6, 6, &fr);
+    AliasingPoint axis = {.face = -1, .depth = 2.0};
+    AliasingReport rep = {sc, "aliasing", "", m, an, &fr, &axis, 1, 0.0};
+    CHECK_MSG(aliasing_report_write(&rep, test_tmpdir(), "al", false, &err), "%s", err.msg);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/al.json", test_tmpdir());
+    char *json = file_read_all(path, NULL, &err);
+    CHECK(json);
+    const char *frustum = strstr(json, "\"frustum\""), *total = strstr(json, "\"total_aliasing_storage\"");
+    const char *factor = strstr(json, "\"storage_factor\"");
+    printf("    samples: total_aliasing_storage %.4g; frustum: storage_factor %.4g\n", an->sum.storage, fr.storage);
+    bool named = frustum && total && total < frustum && factor && factor > frustum &&
+                 !strstr(factor + 1, "\"storage_factor\"") && !strstr(total + 1, "\"total_aliasing_storage\"");
+    free(json);
+    CHECK_MSG(named, "aliasing.json does not name the samples' and the frustum's storage apart");
+    lab_close(lab);
 }
