@@ -269,13 +269,15 @@ const AliasingMap *res_aliasing(ResourceManager *rm, const Scene *scene, int lig
 
 /* ---- over the frustum ----------------------------------------------------------------- */
 
-/* Lloyd et al. 2006 take the maximum error over the frustum; for each
- * map it lies on the boundary of the part of B the map serves (the near
- * plane, B's faces and edges, a cascade's split plane, a frustum face's
- * partition plane), so the measure probes that boundary exactly and then
- * climbs to each map's maxima. A probe is an image position (sx, sy) in
- * [-1, 1]^2 and tau in [0, 1]: the log-spaced place along that ray's span
- * [d0, d1] inside B, view depth d0 (d1 / d0)^tau. */
+/* Lloyd et al. 2006 (§3) take the maximum error over the frustum; for
+ * each map it lies on the boundary of the part of B the map serves (the
+ * near plane, B's faces and edges, a cascade's split plane, a frustum
+ * face's partition plane). The measure probes B's boundary exactly (image
+ * edges, each ray's entry and exit), finds every map change a ray crosses
+ * by bisection, and climbs from each map's highest probe to boundaries no
+ * ray crosses (planes through the eye). A probe is an image position
+ * (sx, sy) in [-1, 1]^2 and tau in [0, 1]: the log-spaced place along that
+ * ray's span [d0, d1] inside B, view depth d0 (d1 / d0)^tau. */
 #define TRANSITION_STEPS 40 /* bisections of a map change along a ray: tau to 2^-40 */
 #define CLIMB_HALVINGS 24   /* a climb's step shrinks from one node spacing to 2^-24 of it */
 #define CLIMB_MOVES 64      /* and moves at most this many times (it starts within a spacing of its peak) */
@@ -294,8 +296,8 @@ typedef struct FrustumProbe {
     FrustumPeak peak[LIGHTVIEW_MAX_FACES][2]; /* per map, the largest m_s [0] and m_t [1] probed */
 } FrustumProbe;
 
-/* Node i of n over [lo, hi], both ends included (n = 1: lo). */
-static double node(int i, int n, double lo, double hi) { return n > 1 ? lo + (hi - lo) * i / (n - 1) : lo; }
+/* Node i of n over [lo, hi], both ends included (n = 1: the middle). */
+static double node(int i, int n, double lo, double hi) { return n > 1 ? lo + (hi - lo) * i / (n - 1) : 0.5 * (lo + hi); }
 
 /* The view depths [*d0, *d1] where the ray through image position (sx, sy)
  * is inside both the frustum's depth range and the scene's bounds (slab
