@@ -7,14 +7,20 @@
 -- warping) and with the light behind the viewer (no warping possible).
 -- Measured by lab:aliasing's frustum measure (resources/aliasing.h): Lloyd's
 -- maximum perspective aliasing error over the view frustum (each point's
--- normal bisects eye and light directions), N^3 points; storage factor
--- S = sum over maps of res^2 max(m_s) max(m_t) / screen pixels, the texels
--- needed for error <= 1 everywhere, over the screen's pixels (independent
--- of the map size). Scene: scenes/frustum-box.lua (B = the whole frustum,
--- z_f / z_n = 100, 60 degrees, 320 x 240).
+-- normal bisects eye and light directions), probed at N x N rays (image
+-- edges and corners included) x N depths along each (its ends in B
+-- included), every map change along a ray bisected, then a climb to each
+-- map's maxima; storage factor S = sum over maps of res^2 max(m_s) max(m_t)
+-- / screen pixels, the texels needed for error <= 1 everywhere, over the
+-- screen's pixels (independent of the map size). The maxima lie on the
+-- boundary of each map's region, so the probes there make S converge from
+-- below in N: the convergence table (N = 2 ... 64, the two configurations
+-- of issue 12 §4) is in summary.md and convergence.csv. Scene:
+-- scenes/frustum-box.lua (B = the whole frustum, z_f / z_n = 100,
+-- 60 degrees, 320 x 240).
 --   build/shadowlab run experiments/fig3-13-storage-factor.lua [--out DIR] [--points N]
--- Writes DIR (default reports/fig3-13): storage.csv, plots/overhead.*,
--- plots/behind.*, summary.md.
+-- Writes DIR (default reports/fig3-13): storage.csv, convergence.csv,
+-- plots/overhead.*, plots/behind.*, summary.md.
 local sl = require "shadowlab"
 local plot = require "shadowlab.plot"
 local flags = require "shadowlab.flags"
@@ -26,9 +32,14 @@ local LIGHTS = { { name = "overhead", dir = { 0, -1, 0 }, label = "overhead ligh
                  { name = "behind", dir = { 0, 0, -1 }, label = "light behind the viewer" } }
 local MAX_MAPS = 8
 
-local function storage(lab, params)
+local CONVERGENCE = { points = { 2, 4, 8, 16, 24, 64 },
+                      configs = { { light = "overhead", scheme = "uniform", params = { projection = "ortho" } },
+                                  { light = "behind", scheme = "FP+W",
+                                    params = { projection = "lispsm", split_scheme = "faces" } } } }
+
+local function storage(lab, params, n)
   params.fit = "body"
-  local a = lab:aliasing{ params = params, frustum = points }
+  local a = lab:aliasing{ params = params, frustum = n or points }
   return a.frustum, a.map.faces
 end
 
@@ -38,8 +49,20 @@ local md = { "# Course Fig. 3.13: storage factor against the number of shadow ma
              "60 degrees, 320 x 240): storage factor = texels needed for a maximum error of 1 on both axes, over " ..
              "the screen's pixels. ZP: log splits, uniform maps; W: one LiSPSM map (n_opt, Lloyd's falloff); " ..
              "ZP+W: LiSPSM per slice; FP: one map per light-facing frustum face (uniform), FP+W: warped per face.", "" }
+local conv_csv, conv_rows = { "light,scheme,maps,points,storage_factor" }, {}
 for _, light in ipairs(LIGHTS) do
   local lab <close> = sl.open("scenes/frustum-box.lua", { ["lights[1].direction"] = light.dir })
+  for _, c in ipairs(CONVERGENCE.configs) do
+    if c.light == light.name then
+      local row = { string.format("%s, %s", light.label, c.scheme) }
+      for _, n in ipairs(CONVERGENCE.points) do
+        local fr, faces = storage(lab, { projection = c.params.projection, split_scheme = c.params.split_scheme }, n)
+        conv_csv[#conv_csv + 1] = string.format("%s,%s,%d,%d,%.6g", light.name, c.scheme, faces, n, fr.storage_factor)
+        row[#row + 1] = string.format("%.5g", fr.storage_factor)
+      end
+      conv_rows[#conv_rows + 1] = row
+    end
+  end
   local series, table_rows = {}, {}
   local function add(scheme, maps, fr)
     csv[#csv + 1] = string.format("%s,%s,%d,%.6g,%.6g,%.6g,%d", light.name, scheme, maps, fr.storage_factor,
@@ -85,8 +108,17 @@ for _, light in ipairs(LIGHTS) do
   md[#md + 1] = string.format("![%s](plots/%s.svg)", light.label, light.name)
   md[#md + 1] = ""
 end
+md[#md + 1] = "## Convergence in the number of points (one map, or FP+W's five)"
+md[#md + 1] = ""
+local head, rule = { "| configuration |" }, { "|---|" }
+for _, n in ipairs(CONVERGENCE.points) do head[#head + 1] = string.format(" %d |", n); rule[#rule + 1] = "---:|" end
+md[#md + 1] = table.concat(head)
+md[#md + 1] = table.concat(rule)
+for _, row in ipairs(conv_rows) do md[#md + 1] = "| " .. table.concat(row, " | ") .. " |" end
+md[#md + 1] = ""
 sl.mkdir(out)
 sl.write_file(out .. "/storage.csv", table.concat(csv, "\n") .. "\n")
+sl.write_file(out .. "/convergence.csv", table.concat(conv_csv, "\n") .. "\n")
 sl.write_file(out .. "/summary.md", table.concat(md, "\n") .. "\n")
 print(table.concat(md, "\n"))
-print("wrote " .. out .. "/{storage.csv,summary.md,plots/}")
+print("wrote " .. out .. "/{storage.csv,convergence.csv,summary.md,plots/}")

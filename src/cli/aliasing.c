@@ -1,8 +1,8 @@
 /* aliasing.c -- `shadowlab aliasing SCENE [-t TECH] [-p K=V]...`: the
  * sampling-error analysis (course §3.1; resources/aliasing.h) of the shadow
  * map a technique renders with -- any projection, warp, fit or cascades of
- * the shared map parameters -- over the view samples, and Lloyd's measure
- * over the view frustum; writes lab/aliasing_report.h's files and prints
+ * the shared map parameters -- over the view samples, and Lloyd's storage
+ * factor over the view frustum; writes lab/aliasing_report.h's files and prints
  * the summary. */
 #include <stdlib.h>
 #include <string.h>
@@ -19,8 +19,9 @@ static const CliAccept aliasing_options[] = {
     {OPT_PARAM, "its parameters (repeatable): map_size, projection, fit, warp_n, cascades, ..."},
     {OPT_SET, NULL},
     {OPT_LIGHT, NULL},
-    {OPT_FRUSTUM, "also Lloyd's measure over the view frustum at N x N image points x N depths\n"
-                  "(perspective aliasing only; default 24, 0: off)"},
+    {OPT_FRUSTUM, "also Lloyd's storage factor over the view frustum (perspective aliasing only): N x N rays,\n"
+                  "edges included, x N depths in B, ends included, map changes bisected, then a climb to each\n"
+                  "map's maxima (default 24, 0: off)"},
     {OPT_THREADS, NULL},
     {OPT_OUT, NULL},
     {OPT_NO_PNG, "skip the PNGs"},
@@ -30,8 +31,9 @@ static const CliCommand aliasing_cmd = {
     "aliasing", "SCENE [options]", true, aliasing_options,
     "writes DIR/aliasing.{exr,png,json}, aliasing-cascade.png, aliasing-hist.csv, aliasing-depth.csv,\n"
     "aliasing-axis.csv: m = pixels per texel step along the map's axes (> 1: undersampled), its histogram,\n"
-    "its profile along view depth, the projection factor cos(alpha)/cos(beta), the storage factor (Lloyd et\n"
-    "al. 2006), and along the view axis the catalogue's normalised e_x, e_y (course Fig. 3.7)\n"};
+    "its profile along view depth, the projection factor cos(alpha)/cos(beta), the samples' total-aliasing\n"
+    "storage (projection aliasing included), Lloyd et al. 2006's storage factor over the frustum, and along\n"
+    "the view axis the catalogue's normalised e_x, e_y (course Fig. 3.7)\n"};
 
 /* "name=value" of the map parameters that differ from the defaults. */
 static void params_text(const Technique *t, const double *p, char *out, size_t n)

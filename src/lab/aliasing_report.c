@@ -136,7 +136,7 @@ static void json_summary(JsonWriter *w, const char *key, const AliasingSummary *
     json_number(w, "m_t_max", s->m_t_max);
     json_number(w, "m_s_mean", s->m_s_mean);
     json_number(w, "m_t_mean", s->m_t_mean);
-    json_number(w, "storage_factor", s->storage);
+    json_number(w, aliasing_storage_name(s), s->storage);
     json_array_begin(w, "faces");
     for (int f = 0; f < s->num_faces && f < LIGHTVIEW_MAX_FACES; f++) {
         json_object_begin(w, NULL);
@@ -195,9 +195,10 @@ bool aliasing_report_write(const AliasingReport *r, const char *dir, const char 
 static void print_summary(FILE *fp, const char *what, const AliasingSummary *s)
 {
     fprintf(fp, "%-9s %8ld measured, %5.1f%% undersampled (m > 1), %ld edge-on to the light; m max %.4g mean %.4g; "
-                "m_s max %.4g mean %.4g; m_t max %.4g mean %.4g; storage factor %.4g\n",
+                "m_s max %.4g mean %.4g; m_t max %.4g mean %.4g; %s %.4g\n",
             what, s->measured, s->measured ? 100.0 * s->undersampled / s->measured : 0.0, s->singular, s->m_max,
-            s->m_mean, s->m_s_max, s->m_s_mean, s->m_t_max, s->m_t_mean, s->storage);
+            s->m_mean, s->m_s_max, s->m_s_mean, s->m_t_max, s->m_t_mean,
+            s->perspective_only ? "storage factor" : "total-aliasing storage", s->storage);
 }
 
 void aliasing_report_print(const AliasingReport *r, FILE *fp)

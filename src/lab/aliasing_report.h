@@ -16,7 +16,7 @@ typedef struct AliasingReport {
     const char *params_text;        /* "name=value ..." of those parameters */
     const ShadowMap *map;
     const AliasingMap *samples;     /* over the view samples */
-    const AliasingSummary *frustum; /* Lloyd's measure over the view frustum, or NULL */
+    const AliasingSummary *frustum; /* Lloyd's storage factor over the view frustum, or NULL */
     const AliasingPoint *axis;      /* along the view axis (aliasing_on_axis), face -1 where not measured */
     int num_axis;
     double seconds;                 /* the analysis's own time */

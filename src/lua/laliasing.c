@@ -10,10 +10,12 @@
  *           image = Image with channels m, m_s, m_t, proj, cascade (when asked) }
  * SUMMARY = {measured, undersampled, undersampled_share, singular (edge-on to the
  *            light, left out of the statistics), m_max, m_mean, m_s_max,
- *            m_t_max, m_s_mean, m_t_mean, storage_factor, faces = {{measured,
- *            m_s_max, m_t_max}, ...}, hist = {{lo, hi, count}, ...}, depth =
- *            {{z_lo, z_hi, count, m_s_mean, m_t_mean, m_s_max, m_t_max,
- *            persp_s_mean, persp_t_mean}, ...}}. */
+ *            m_t_max, m_s_mean, m_t_mean, storage_factor (frustum: Lloyd's,
+ *            perspective aliasing) or total_aliasing_storage (samples:
+ *            projection aliasing included), faces = {{measured, m_s_max,
+ *            m_t_max}, ...}, hist = {{lo, hi, count}, ...}, depth = {{z_lo,
+ *            z_hi, count, m_s_mean, m_t_mean, m_s_max, m_t_max, persp_s_mean,
+ *            persp_t_mean}, ...}}. */
 #include <string.h>
 #include "lua/sl_lua.h"
 #include "resources/aliasing.h"
@@ -51,7 +53,7 @@ static void push_summary(lua_State *L, const AliasingSummary *s)
     set_num(L, "m_t_max", s->m_t_max);
     set_num(L, "m_s_mean", s->m_s_mean);
     set_num(L, "m_t_mean", s->m_t_mean);
-    set_num(L, "storage_factor", s->storage);
+    set_num(L, aliasing_storage_name(s), s->storage);
     static const char *const face_cols[] = {"measured", "m_s_max", "m_t_max"};
     double faces[LIGHTVIEW_MAX_FACES * 3];
     for (int f = 0; f < s->num_faces; f++) {

@@ -86,12 +86,41 @@ void aliasing_normalised(const AliasingView *av, int res, const AliasingPoint *p
 
 double aliasing_hist_edge(int b) { return pow(10.0, -2.0 + 4.0 * b / ALIASING_HIST_BINS); }
 
-void aliasing_summary_init(AliasingSummary *s, int num_faces, double depth_lo, double depth_hi)
+const char *aliasing_storage_name(const AliasingSummary *s)
+{
+    return s->perspective_only ? "storage_factor" : "total_aliasing_storage";
+}
+
+void aliasing_summary_init(AliasingSummary *s, int num_faces, double depth_lo, double depth_hi, bool perspective_only)
 {
     memset(s, 0, sizeof *s);
     s->num_faces = num_faces;
+    s->perspective_only = perspective_only;
     s->depth_lo = fmax(depth_lo, 1e-300);
     s->depth_hi = fmax(depth_hi, s->depth_lo * (1.0 + 1e-12));
+}
+
+/* Depth-profile bin of view depth z (log bins over the summary's range). */
+static int depth_bin(const AliasingSummary *s, double z)
+{
+    double t = log(z / s->depth_lo) / log(s->depth_hi / s->depth_lo);
+    int k = (int)floor(t * ALIASING_DEPTH_BINS);
+    return k < 0 ? 0 : k >= ALIASING_DEPTH_BINS ? ALIASING_DEPTH_BINS - 1 : k;
+}
+
+/* The maxima alone (overall, per depth bin, per face) of a finite point. */
+static void raise_maxima(AliasingSummary *s, const AliasingPoint *pt)
+{
+    s->m_max = fmax(s->m_max, fmax(pt->m_s, pt->m_t));
+    s->m_s_max = fmax(s->m_s_max, pt->m_s);
+    s->m_t_max = fmax(s->m_t_max, pt->m_t);
+    int k = depth_bin(s, pt->depth);
+    s->depth_m_s_max[k] = fmax(s->depth_m_s_max[k], pt->m_s);
+    s->depth_m_t_max[k] = fmax(s->depth_m_t_max[k], pt->m_t);
+    if (pt->face >= 0 && pt->face < LIGHTVIEW_MAX_FACES) {
+        s->face_m_s_max[pt->face] = fmax(s->face_m_s_max[pt->face], pt->m_s);
+        s->face_m_t_max[pt->face] = fmax(s->face_m_t_max[pt->face], pt->m_t);
+    }
 }
 
 void aliasing_summary_add(AliasingSummary *s, const AliasingPoint *pt)
@@ -104,29 +133,19 @@ void aliasing_summary_add(AliasingSummary *s, const AliasingPoint *pt)
         s->hist[ALIASING_HIST_BINS - 1]++;
         return;
     }
-    s->m_max = fmax(s->m_max, m);
+    raise_maxima(s, pt);
     s->m_mean += m;
-    s->m_s_max = fmax(s->m_s_max, pt->m_s);
-    s->m_t_max = fmax(s->m_t_max, pt->m_t);
     s->m_s_mean += pt->m_s;
     s->m_t_mean += pt->m_t;
     int b = (int)floor((log10(fmax(m, 1e-300)) + 2.0) * ALIASING_HIST_BINS / 4.0);
     s->hist[b < 0 ? 0 : b >= ALIASING_HIST_BINS ? ALIASING_HIST_BINS - 1 : b]++;
-    double t = log(pt->depth / s->depth_lo) / log(s->depth_hi / s->depth_lo);
-    int k = (int)floor(t * ALIASING_DEPTH_BINS);
-    k = k < 0 ? 0 : k >= ALIASING_DEPTH_BINS ? ALIASING_DEPTH_BINS - 1 : k;
+    int k = depth_bin(s, pt->depth);
     s->depth_count[k]++;
     s->depth_m_s[k] += pt->m_s;
     s->depth_m_t[k] += pt->m_t;
-    s->depth_m_s_max[k] = fmax(s->depth_m_s_max[k], pt->m_s);
-    s->depth_m_t_max[k] = fmax(s->depth_m_t_max[k], pt->m_t);
     s->depth_persp_s[k] += pt->m_s / fmax(pt->proj, 1e-12);
     s->depth_persp_t[k] += pt->m_t / fmax(pt->proj, 1e-12);
-    if (pt->face >= 0 && pt->face < LIGHTVIEW_MAX_FACES) {
-        s->face_count[pt->face]++;
-        s->face_m_s_max[pt->face] = fmax(s->face_m_s_max[pt->face], pt->m_s);
-        s->face_m_t_max[pt->face] = fmax(s->face_m_t_max[pt->face], pt->m_t);
-    }
+    if (pt->face >= 0 && pt->face < LIGHTVIEW_MAX_FACES) s->face_count[pt->face]++;
 }
 
 void aliasing_summary_finish(AliasingSummary *s, int res, int width, int height)
@@ -221,7 +240,7 @@ static void *build_aliasing(const void *args_, Error *err)
     }
     measure_samples(a, args, vs, cls);
     const Camera *cam = &args->scene->camera;
-    aliasing_summary_init(&a->sum, args->map->num_faces, cam->near_dist, cam->far_dist);
+    aliasing_summary_init(&a->sum, args->map->num_faces, cam->near_dist, cam->far_dist, false);
     for (size_t s = 0; s < n; s++) {
         if (a->face[s] < 0) continue;
         AliasingPoint pt = {a->m_s[s], a->m_t[s], a->proj[s], a->face[s], vs->depth_view[s]};
@@ -250,26 +269,168 @@ const AliasingMap *res_aliasing(ResourceManager *rm, const Scene *scene, int lig
 
 /* ---- over the frustum ----------------------------------------------------------------- */
 
-static bool inside_box(const Scene *sc, dvec3 p)
+/* Lloyd et al. 2006 (§3) take the maximum error over the frustum; for
+ * each map it lies on the boundary of the part of B the map serves (the
+ * near plane, B's faces and edges, a cascade's split plane, a frustum
+ * face's partition plane). The measure probes B's boundary exactly (image
+ * edges, each ray's entry and exit), finds every map change a ray crosses
+ * by bisection, and climbs from each map's highest probe to boundaries no
+ * ray crosses (planes through the eye). A probe is an image position
+ * (sx, sy) in [-1, 1]^2 and tau in [0, 1]: the log-spaced place along that
+ * ray's span [d0, d1] inside B, view depth d0 (d1 / d0)^tau. */
+#define TRANSITION_STEPS 40 /* bisections of a map change along a ray: tau to 2^-40 */
+#define CLIMB_HALVINGS 24   /* a climb's step shrinks from one node spacing to 2^-24 of it */
+#define CLIMB_MOVES 64      /* and moves at most this many times (it starts within a spacing of its peak) */
+
+typedef struct FrustumPeak {
+    double at[3];  /* sx, sy, tau */
+    double value;  /* m_s or m_t there; 0: none yet */
+} FrustumPeak;
+
+typedef struct FrustumProbe {
+    const LightView *lv;
+    const Scene *scene;
+    const Light *light;
+    AliasingView av;
+    AliasingSummary *out;
+    FrustumPeak peak[LIGHTVIEW_MAX_FACES][2]; /* per map, the largest m_s [0] and m_t [1] probed */
+} FrustumProbe;
+
+/* Node i of n over [lo, hi], both ends included (n = 1: the middle). */
+static double node(int i, int n, double lo, double hi) { return n > 1 ? lo + (hi - lo) * i / (n - 1) : 0.5 * (lo + hi); }
+
+/* The view depths [*d0, *d1] where the ray through image position (sx, sy)
+ * is inside both the frustum's depth range and the scene's bounds (slab
+ * clipping, Kay & Kajiya 1986); false where it misses the box. */
+static bool ray_span(const ViewFrustum *f, const Scene *sc, double sx, double sy, double *d0, double *d1)
 {
-    return p.x >= sc->bounds_min.x && p.x <= sc->bounds_max.x && p.y >= sc->bounds_min.y &&
-           p.y <= sc->bounds_max.y && p.z >= sc->bounds_min.z && p.z <= sc->bounds_max.z;
+    dvec3 dir = d3_sub(frustum_point(f, sx, sy, 1.0), f->eye); /* world units per unit view depth */
+    const double o[3] = {f->eye.x, f->eye.y, f->eye.z}, v[3] = {dir.x, dir.y, dir.z};
+    const double lo[3] = {sc->bounds_min.x, sc->bounds_min.y, sc->bounds_min.z};
+    const double hi[3] = {sc->bounds_max.x, sc->bounds_max.y, sc->bounds_max.z};
+    double a = f->near, b = f->far;
+    for (int k = 0; k < 3; k++) {
+        if (v[k] == 0.0) {
+            if (o[k] < lo[k] || o[k] > hi[k]) return false;
+            continue;
+        }
+        double t0 = (lo[k] - o[k]) / v[k], t1 = (hi[k] - o[k]) / v[k];
+        if (t0 > t1) {
+            double t = t0;
+            t0 = t1;
+            t1 = t;
+        }
+        if (t0 > a) a = t0;
+        if (t1 < b) b = t1;
+    }
+    *d0 = a;
+    *d1 = b;
+    return a <= b;
+}
+
+/* The instrument at a probe; its map's index, or -1 where not measured. */
+static int probe_at(const FrustumProbe *p, const double at[3], AliasingPoint *pt)
+{
+    double d0, d1;
+    if (!ray_span(&p->av.frustum, p->scene, at[0], at[1], &d0, &d1)) return -1;
+    dvec3 x = frustum_point(&p->av.frustum, at[0], at[1], d0 * pow(d1 / d0, at[2]));
+    return half_vector_at(p->lv, &p->av, p->light, x, pt) && pt->m_s < ALIASING_M_CAP && pt->m_t < ALIASING_M_CAP
+               ? pt->face
+               : -1;
+}
+
+/* Keep a probe's point in the summary and as its map's peak when higher. */
+static void keep(FrustumProbe *p, const AliasingPoint *pt, const double at[3])
+{
+    aliasing_summary_add(p->out, pt);
+    const double m[2] = {pt->m_s, pt->m_t};
+    for (int a = 0; a < 2; a++) {
+        FrustumPeak *k = &p->peak[pt->face][a];
+        if (m[a] > k->value) *k = (FrustumPeak){{at[0], at[1], at[2]}, m[a]};
+    }
+}
+
+/* A map change (or the map's edge) between tau lo and hi on a ray: bisect
+ * it and keep the last point on lo's side and the first on hi's (the
+ * nodes themselves are kept already). */
+static void add_transition(FrustumProbe *p, double sx, double sy, double lo, double hi, int face_lo)
+{
+    AliasingPoint at_lo, at_hi;
+    double where_lo[3] = {sx, sy, lo}, where_hi[3] = {sx, sy, hi};
+    bool got_lo = false, got_hi = false;
+    for (int i = 0; i < TRANSITION_STEPS; i++) {
+        double mid[3] = {sx, sy, 0.5 * (where_lo[2] + where_hi[2])};
+        AliasingPoint pt;
+        int face = probe_at(p, mid, &pt);
+        bool low_side = face == face_lo;
+        memcpy(low_side ? where_lo : where_hi, mid, sizeof mid);
+        *(low_side ? &at_lo : &at_hi) = pt;
+        *(low_side ? &got_lo : &got_hi) = face >= 0;
+    }
+    if (got_lo) keep(p, &at_lo, where_lo);
+    if (got_hi) keep(p, &at_hi, where_hi);
+}
+
+/* nz nodes along the ray through (sx, sy), both ends of its span included,
+ * and every map change between them. */
+static void add_ray(FrustumProbe *p, double sx, double sy, int nz)
+{
+    int prev_face = -1;
+    for (int k = 0; k < nz; k++) {
+        double at[3] = {sx, sy, node(k, nz, 0.0, 1.0)};
+        AliasingPoint pt;
+        int face = probe_at(p, at, &pt);
+        if (k > 0 && face != prev_face) add_transition(p, sx, sy, node(k - 1, nz, 0.0, 1.0), at[2], prev_face);
+        if (face >= 0) keep(p, &pt, at);
+        prev_face = face;
+    }
+}
+
+/* From a map's highest probe of m_s (axis 0) or m_t (1), a compass search
+ * (Hooke & Jeeves 1961) over (sx, sy, tau) within the domain and that
+ * map's region: it moves to the best higher neighbour at step h and halves
+ * h when none is higher. Only the maxima take its points (the means and
+ * counts stay the grid's). */
+static void climb(FrustumProbe *p, int face, int axis, const double h0[3])
+{
+    FrustumPeak best = p->peak[face][axis];
+    if (!(best.value > 0.0)) return;
+    static const double lo[3] = {-1.0, -1.0, 0.0}, hi[3] = {1.0, 1.0, 1.0};
+    double h[3] = {h0[0], h0[1], h0[2]};
+    int moves = 0;
+    for (int halvings = 0; halvings < CLIMB_HALVINGS && moves < CLIMB_MOVES;) {
+        FrustumPeak next = best;
+        AliasingPoint next_pt;
+        for (int c = 0; c < 6; c++) {
+            double at[3] = {best.at[0], best.at[1], best.at[2]};
+            at[c / 2] = fmin(fmax(at[c / 2] + (c % 2 ? h[c / 2] : -h[c / 2]), lo[c / 2]), hi[c / 2]);
+            AliasingPoint pt;
+            double m = probe_at(p, at, &pt) == face ? (axis ? pt.m_t : pt.m_s) : 0.0;
+            if (m > next.value) {
+                next = (FrustumPeak){{at[0], at[1], at[2]}, m};
+                next_pt = pt;
+            }
+        }
+        if (next.value > best.value) {
+            best = next;
+            raise_maxima(p->out, &next_pt);
+            moves++;
+        } else {
+            for (int k = 0; k < 3; k++) h[k] *= 0.5;
+            halvings++;
+        }
+    }
 }
 
 void aliasing_frustum(const LightView *lv, const Scene *scene, const Light *light, int nx, int ny, int nz,
                       AliasingSummary *out)
 {
-    AliasingView av = aliasing_view(&scene->camera);
-    const ViewFrustum *f = &av.frustum;
-    aliasing_summary_init(out, lv->num_faces, f->near, f->far);
-    for (int k = 0; k < nz; k++) {
-        double d = f->near * pow(f->far / f->near, (k + 0.5) / nz);
-        for (int j = 0; j < ny; j++)
-            for (int i = 0; i < nx; i++) {
-                dvec3 p = frustum_point(f, 2.0 * (i + 0.5) / nx - 1.0, 2.0 * (j + 0.5) / ny - 1.0, d);
-                AliasingPoint pt;
-                if (inside_box(scene, p) && half_vector_at(lv, &av, light, p, &pt)) aliasing_summary_add(out, &pt);
-            }
-    }
+    FrustumProbe p = {.lv = lv, .scene = scene, .light = light, .av = aliasing_view(&scene->camera), .out = out};
+    aliasing_summary_init(out, lv->num_faces, p.av.frustum.near, p.av.frustum.far, true);
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++) add_ray(&p, node(i, nx, -1.0, 1.0), node(j, ny, -1.0, 1.0), nz);
+    const double h0[3] = {nx > 1 ? 2.0 / (nx - 1) : 1.0, ny > 1 ? 2.0 / (ny - 1) : 1.0, nz > 1 ? 1.0 / (nz - 1) : 0.5};
+    for (int f = 0; f < lv->num_faces && f < LIGHTVIEW_MAX_FACES; f++)
+        for (int axis = 0; axis < 2; axis++) climb(&p, f, axis, h0);
     aliasing_summary_finish(out, lv->res, scene->camera.width, scene->camera.height);
 }

@@ -11,7 +11,8 @@
  * perspective factor. The per-sample analysis is a resource (built only
  * when asked for, keyed by the map and the view), with its summary:
  * undersampled share, max and mean, histogram, profile along view depth,
- * and Lloyd's storage factor. */
+ * and the storage the maps need for m <= 1 (Lloyd's storage factor over the
+ * frustum, the total-aliasing storage over the samples). */
 #ifndef SL_ALIASING_H
 #define SL_ALIASING_H
 #include "resources/lightbody.h"
@@ -59,10 +60,15 @@ typedef struct AliasingSummary {
                                              undersampled, left out of every statistic below */
     double m_max, m_mean;                 /* of max(m_s, m_t) */
     double m_s_max, m_t_max, m_s_mean, m_t_mean;
-    /* Lloyd's storage factor: texels the maps would need for m <= 1 at
-     * every measured point, over the screen's pixels, both axes:
-     * sum over faces of res^2 max(m_s) max(m_t) / (width height). */
+    /* Texels the maps would need for m <= 1 at every measured point, over
+     * the screen's pixels, both axes: sum over faces of res^2 max(m_s)
+     * max(m_t) / (width height). Over the frustum (perspective_only) it is
+     * Lloyd et al. 2006's storage factor; over the view samples m includes
+     * projection aliasing (cos(alpha) / cos(beta), unbounded near grazing
+     * light), so it is the total-aliasing storage, another and far larger
+     * quantity (aliasing_storage_name). */
     double storage;
+    bool perspective_only;                /* each point's normal bisects the eye and light directions */
     long hist[ALIASING_HIST_BINS];
     double depth_lo, depth_hi;            /* the profile's range (the camera's near and far) */
     long depth_count[ALIASING_DEPTH_BINS];
@@ -75,9 +81,12 @@ typedef struct AliasingSummary {
 } AliasingSummary;
 
 /* Accumulate measurements into a summary (res: texels per side of each face). */
-void aliasing_summary_init(AliasingSummary *s, int num_faces, double depth_lo, double depth_hi);
+void aliasing_summary_init(AliasingSummary *s, int num_faces, double depth_lo, double depth_hi, bool perspective_only);
 void aliasing_summary_add(AliasingSummary *s, const AliasingPoint *pt);
 void aliasing_summary_finish(AliasingSummary *s, int res, int width, int height);
+/* The name of s->storage in records, Lua and printouts: "storage_factor"
+ * (perspective only) or "total_aliasing_storage" (projection included). */
+const char *aliasing_storage_name(const AliasingSummary *s);
 /* Lower edge of histogram bin b as m (bin 0 also takes everything below). */
 double aliasing_hist_edge(int b);
 
@@ -92,11 +101,16 @@ typedef struct AliasingMap {
 const AliasingMap *res_aliasing(ResourceManager *rm, const Scene *scene, int light_index, const ShadowMap *map,
                                 Error *err);
 
-/* Lloyd et al. 2006's measure over the view frustum, not the samples:
- * perspective aliasing only (each point's normal bisects the directions to
- * the eye and to the light, so cos(alpha) = cos(beta)), at an nx x ny grid
- * of image positions times nz view depths (log spaced over near..far),
- * inside the scene's bounds. */
+/* Lloyd et al. 2006's measure over the intersection body B (the view
+ * frustum inside the scene's bounds), not the samples: perspective
+ * aliasing only (each point's normal bisects the directions to the eye and
+ * to the light, so cos(alpha) = cos(beta)). Each map's maximum lies on the
+ * boundary of its region, so the probes include it: nx x ny rays at image
+ * positions -1..1 (edges and corners included), nz view depths along each,
+ * log spaced from its entry into B to its exit (both included), each map
+ * change along a ray bisected; then a climb from each map's highest m_s
+ * and m_t raises the maxima (s->storage converges from below in the
+ * points; counts and means are the probes'). */
 void aliasing_frustum(const LightView *lv, const Scene *scene, const Light *light, int nx, int ny, int nz,
                       AliasingSummary *out);
 

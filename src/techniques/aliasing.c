@@ -7,7 +7,7 @@
  * m_t (pixels per texel step along each map axis; > 1 undersampled), the
  * projection factor cos(alpha)/cos(beta) of Eq. 3.1, and the cascade used
  * (1-based; 0 where nothing was measured). `shadowlab aliasing` writes the
- * full report (colour map, histogram, profile along depth, storage factor). */
+ * full report (colour map, histogram, profile along depth, storage). */
 #include <stdlib.h>
 #include "resources/aliasing.h"
 #include "techniques/smap.h"

@@ -265,6 +265,9 @@ TEST(test_warp_log_splits_bound_the_depth_axis_error)
     lab_close(lab);
 }
 
+/* The instrument differentiates warp_log_forward, the formula this closed
+ * form restates: a check of the formula's constants, not of the map that is
+ * ray cast (test_aliasing_instrument.c compares the two). */
 TEST(test_warp_logpsm_has_constant_error_ln_r)
 {
     Lab *lab = open_plane();

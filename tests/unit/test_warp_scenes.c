@@ -141,10 +141,14 @@ static void check_finite(const char *what, Lab *lab)
         CHECK(an);
         const AliasingSummary *s = &an->sum;
         for (size_t i = 0; i < (size_t)m->num_faces * m->res * m->res; i++) bad += isnan(m->depth[i]);
+        AliasingSummary fr; /* the frustum measure's boundary probes and climbs, on the same extremes */
+        aliasing_frustum(&m->view, lab_scene(lab), &lab_scene(lab)->lights[0], 6, 6, 6, &fr);
         bad += !isfinite(s->m_max) + !isfinite(s->m_mean) + !isfinite(s->storage);
-        printf("    %-11s %-30s %-17s %-18s %5ld measured, m max %-9.4g storage %-9.4g non-finite %ld%s\n",
-               light_kind_name(lab_scene(lab)->lights[0].kind), what, projs[k], parts[k], s->measured, s->m_max,
-               s->storage, bad, m->view.face[0].warp_fallback ? " (fell back)" : "");
+        bad += !isfinite(fr.m_max) + !isfinite(fr.m_mean) + !isfinite(fr.storage);
+        printf("    %-11s %-30s %-17s %-18s %5ld measured, m max %-9.4g %s %-9.4g storage factor %-9.4g "
+               "non-finite %ld%s\n", light_kind_name(lab_scene(lab)->lights[0].kind), what, projs[k], parts[k],
+               s->measured, s->m_max, aliasing_storage_name(s), s->storage, fr.storage, bad,
+               m->view.face[0].warp_fallback ? " (fell back)" : "");
         CHECK_MSG(bad == 0, "%s, %s: %ld non-finite or out-of-range values", what, projs[k], bad);
     }
 }
