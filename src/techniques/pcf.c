@@ -30,7 +30,7 @@ static const ParamDesc pcf_params[] = {
     {"rotate", PARAM_BOOL, 1, 0, 1, "", "poisson and adaptive: rotate the disk per pixel (banding becomes noise)", NULL},
 };
 
-static const char *const pcf_resources[] = {"shadow_map", "view_samples", NULL};
+static const char *const pcf_resources[] = {"shadow_map", "view_samples", "point_table", NULL};
 
 typedef struct PcfState {
     const ShadowMap *map;

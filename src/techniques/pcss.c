@@ -45,7 +45,7 @@ static const ParamDesc pcss_params[] = {
      NULL},
 };
 
-static const char *const pcss_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", NULL};
+static const char *const pcss_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", "point_table", NULL};
 
 /* A tap pattern on [-1, 1]^2: a regular side x side grid or a Poisson disk. */
 typedef struct Pattern {
