@@ -151,18 +151,17 @@ static bool run_evaluations(const RenderRequest *req, const RenderTiming *timing
     return true;
 }
 
-/* The prepare's scope: its resources and their summed own build times. */
-static double collect_tech_resources(const ResourceManager *rm, RenderResult *out, double *built_s)
+/* The prepare's scope: its resources and their own build times summed by
+ * category (the frame's, the G-buffer's, the set-up's). */
+static void collect_tech_resources(const ResourceManager *rm, RenderResult *out)
 {
-    double total = 0;
-    *built_s = 0;
     for (int i = 0; i < rm_scope_count(rm); i++) {
         const ResourceEvent *ev = rm_scope_event(rm, i);
-        total += ev->own_s;
-        if (ev->built) *built_s += ev->own_s;
+        if (ev->category == RES_FRAME) out->tech_build_s += ev->own_s;
+        if (ev->category == RES_GBUFFER) out->gbuffer_s += ev->own_s;
+        if (ev->category == RES_SETUP) out->setup_s += ev->own_s;
         if (i < RENDER_MAX_TECH_RESOURCES) out->tech_resources[out->num_tech_resources++] = *ev;
     }
-    return total;
 }
 
 bool lab_render(Lab *lab, const RenderRequest *req, RenderResult *out, Error *err)
@@ -200,7 +199,7 @@ bool lab_render_timed(Lab *lab, const RenderRequest *req, const RenderTiming *ti
         ctx.aux = out->aux.data;
     }
     void *state = NULL;
-    rm_scope_begin(lab->rm);
+    rm_scope_begin(lab->rm, req->repeat, timing->budget_s); /* frame resources built here: `repeat` times */
     Progress prog;
     progress_begin(&prog, "prepare", 0);
     t0 = timer_now_s();
@@ -212,10 +211,11 @@ bool lab_render_timed(Lab *lab, const RenderRequest *req, const RenderTiming *ti
         render_result_free(out);
         return error_prefix(err, "%s: ", req->tech->name);
     }
-    double built_s;
-    out->tech_build_s = collect_tech_resources(lab->rm, out, &built_s);
+    collect_tech_resources(lab->rm, out);
+    double own_s = out->prepare_s - rm_scope_build_s(lab->rm);
+    out->prepare_own_s = own_s > 0.0 ? own_s : 0.0;
     bool ok = run_evaluations(req, timing, state, &ctx, out);
-    out->frame_s = out->tech_build_s + fmax(0.0, out->prepare_s - built_s) + out->eval_median_s;
+    out->frame_s = out->tech_build_s + out->prepare_own_s + out->eval_median_s;
     if (req->tech->release) req->tech->release(state);
     if (!ok) {
         render_result_free(out);

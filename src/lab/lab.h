@@ -45,17 +45,21 @@ typedef struct RenderResult {
     int repeat;
     int warmup;
     /* What the technique's prepare depends on (a resources.h scope: what it
-     * acquired and what those were built from; the first
-     * RENDER_MAX_TECH_RESOURCES listed, all counted in tech_build_s). */
+     * acquired and what those were built from, each with its category; the
+     * first RENDER_MAX_TECH_RESOURCES listed, all counted below). */
     ResourceEvent tech_resources[RENDER_MAX_TECH_RESOURCES];
     int num_tech_resources;
-    double tech_build_s;   /* sum of their own build times, also when reused here */
+    double tech_build_s;   /* sum of the frame ones' own build times (medians of `repeat` builds), also when reused */
+    double gbuffer_s;      /* sum of the G-buffer ones' (view samples, classes, their BVH): left out */
+    double setup_s;        /* sum of the set-up ones' (constant tables, built once): left out */
+    double prepare_own_s;  /* prepare_s net of the builds inside it, every repeat and category */
     /* Frame time: what one frame costs a renderer that rebuilds the
      * technique's resources every frame (a shadow map is re-rendered each
-     * frame) = tech_build_s + the prepare's own set-up (prepare_s net of the
-     * builds inside it) + eval_median_s. It leaves out the engine's view
-     * samples and classes (a renderer's G-buffer) and the reference, and is
-     * the same whether this run built the resources or reused them. */
+     * frame) = tech_build_s + prepare_own_s + eval_median_s. A reduction the
+     * map's fit makes over the view samples (fit=view's bounds, SDSM's
+     * min/max) is in the map's own build time. It leaves out the G-buffer,
+     * the set-up tables and the reference, and is the same whether this run
+     * built the resources or reused them. */
     double frame_s;
 } RenderResult;
 

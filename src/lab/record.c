@@ -175,7 +175,12 @@ static void write_timings(JsonWriter *w, const RunReport *r)
         json_number(w, "evaluate_min", r->render->eval_min_s);
         json_int(w, "repeat", r->render->repeat);
         json_int(w, "warmup", r->render->warmup);
+        /* frame = technique_build + prepare_own + evaluate_median (lab.h); the G-buffer's and
+         * the set-up tables' builds are reported, left out */
         json_number(w, "technique_build", r->render->tech_build_s);
+        json_number(w, "prepare_own", r->render->prepare_own_s);
+        json_number(w, "gbuffer_left_out", r->render->gbuffer_s);
+        json_number(w, "setup_left_out", r->render->setup_s);
         json_number(w, "frame", r->render->frame_s);
     }
     if (r->ref) json_number(w, "reference", r->ref_info->seconds);
@@ -193,8 +198,11 @@ static void write_event(JsonWriter *w, const ResourceEvent *ev)
     hash_hex(ev->key, hex);
     json_string(w, "key", hex);
     json_string(w, "action", ev->built ? "built" : "reused");
-    json_number(w, "build_s", ev->build_s);
+    json_string(w, "category", resource_category_name(ev->category));
+    json_number(w, "build_s", ev->build_s);   /* medians of `builds` builds (resources.h scopes) */
     json_number(w, "own_build_s", ev->own_s);
+    json_int(w, "builds", ev->builds);
+    json_number(w, "cold_own_build_s", ev->cold_own_s);
     json_int(w, "bytes", (long long)ev->bytes);
     json_object_end(w);
 }

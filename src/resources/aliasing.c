@@ -188,7 +188,7 @@ static size_t aliasing_bytes(const void *r)
     return sizeof *a + (size_t)a->width * a->height * (3 * sizeof(float) + sizeof(int8_t));
 }
 
-static const ResourceKind kind_aliasing = {"aliasing", aliasing_bytes, aliasing_destroy};
+static const ResourceKind kind_aliasing = {"aliasing", aliasing_bytes, aliasing_destroy, RES_FRAME};
 
 typedef struct AliasingArgs {
     ResourceManager *rm;

@@ -19,7 +19,7 @@ static size_t sat_bytes(const void *r)
     return sizeof *t + 2 * sizeof(double) * 3 * (size_t)(t->width + 1) * (size_t)(t->height + 1);
 }
 
-static const ResourceKind kind_light_image_sat = {"light_image_sat", sat_bytes, sat_destroy};
+static const ResourceKind kind_light_image_sat = {"light_image_sat", sat_bytes, sat_destroy, RES_FRAME};
 
 static size_t at(const LightImageSat *t, int x, int y, int c)
 {

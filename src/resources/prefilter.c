@@ -149,7 +149,7 @@ static size_t moments_bytes(const void *r)
     return sizeof *mm + (size_t)mm->num_faces * mm->res * mm->res * mm->channels * elem_bytes(mm->spec.f64);
 }
 
-static const ResourceKind kind_moments = {"moments", moments_bytes, moments_destroy};
+static const ResourceKind kind_moments = {"moments", moments_bytes, moments_destroy, RES_FRAME};
 
 typedef struct MomentArgs { const ShadowMap *map; MomentSpec spec; uint64_t key; } MomentArgs;
 
@@ -257,8 +257,8 @@ static size_t prefiltered_bytes(const void *r)
            (size_t)pf->num_faces * pf->channels * sizeof(double);
 }
 
-static const ResourceKind kind_box = {"box_blur", prefiltered_bytes, prefiltered_destroy};
-static const ResourceKind kind_sat = {"sat", prefiltered_bytes, prefiltered_destroy};
+static const ResourceKind kind_box = {"box_blur", prefiltered_bytes, prefiltered_destroy, RES_FRAME};
+static const ResourceKind kind_sat = {"sat", prefiltered_bytes, prefiltered_destroy, RES_FRAME};
 
 typedef struct PrefilterArgs { const MomentMap *mm; PrefilterKind kind; int K; uint64_t key; } PrefilterArgs;
 
@@ -575,7 +575,7 @@ static size_t pyramid_bytes(const void *r)
     return sizeof *p + pyramid_pairs(p) * 2 * sizeof(float);
 }
 
-static const ResourceKind kind_pyramid = {"minmax_pyramid", pyramid_bytes, pyramid_destroy};
+static const ResourceKind kind_pyramid = {"minmax_pyramid", pyramid_bytes, pyramid_destroy, RES_FRAME};
 
 typedef struct PyramidArgs { const ShadowMap *map; uint64_t key; } PyramidArgs;
 
@@ -681,7 +681,7 @@ static size_t buffer_bytes(const void *r)
     return sizeof *b + (size_t)b->num_faces * b->res * b->res * 2 * sizeof(float);
 }
 
-static const ResourceKind kind_buffer = {"minmax_buffer", buffer_bytes, buffer_destroy};
+static const ResourceKind kind_buffer = {"minmax_buffer", buffer_bytes, buffer_destroy, RES_FRAME};
 
 typedef struct BufferArgs { const ShadowMap *map; int level; uint64_t key; } BufferArgs;
 

@@ -2,7 +2,8 @@
  * resources.h). A linear table: runs hold tens of resources, not thousands.
  * Each entry remembers the entries acquired while it was built, so a scope
  * can name a reused resource's dependencies, and its own build time net of
- * those nested builds. */
+ * those nested builds; each build frame knows the category it builds for,
+ * which is what the resources acquired inside it are for too. */
 #include "resources/resources.h"
 #include <stdio.h>
 #include <stdlib.h>
@@ -24,10 +25,13 @@ typedef struct Entry {
     size_t bytes;
     char desc[160];
     IntList deps;    /* entries acquired while it was built */
+    int builds;      /* build_s and own_s are medians of this many builds */
+    double cold_own_s;
 } Entry;
 
-/* A build in progress: what it acquires and how long its nested builds took. */
-typedef struct BuildFrame { IntList deps; double nested_s; } BuildFrame;
+/* A build in progress: what it acquires, how long its nested builds took and
+ * the category they are acquired for. */
+typedef struct BuildFrame { IntList deps; double nested_s; ResourceCategory context; } BuildFrame;
 
 /* A growable list of events, deduplicated by (kind, key). */
 typedef struct EventList { ResourceEvent *ev; int n, cap; } EventList;
@@ -39,26 +43,46 @@ struct ResourceManager {
     BuildFrame frames[RM_MAX_DEPTH];
     int depth;
     bool scoping;
+    int builds;      /* of each frame resource built in the scope (rm_scope_begin) */
+    double budget_s; /* > 0: and no more once they took this long */
+    double scope_build_s;
     EventList scope;
 };
 
+const char *resource_category_name(ResourceCategory c)
+{
+    static const char *const names[] = {"frame", "gbuffer", "setup", "evaluation"};
+    return names[c];
+}
+
 ResourceManager *rm_create(void) { return calloc(1, sizeof(ResourceManager)); }
 
-void rm_clear(ResourceManager *rm)
+/* Destroy the entries, newest first, but the set-up tables when keep_setup;
+ * a kept table forgets its dependencies (it is made from its key alone). */
+static void drop_entries(ResourceManager *rm, bool keep_setup)
 {
     for (int i = rm->count - 1; i >= 0; i--) {
-        rm->entries[i].kind->destroy(rm->entries[i].res);
-        free(rm->entries[i].deps.v);
+        Entry *e = &rm->entries[i];
+        free(e->deps.v);
+        e->deps = (IntList){NULL, 0, 0};
+        if (keep_setup && e->kind->category == RES_SETUP) continue;
+        e->kind->destroy(e->res);
+        e->res = NULL;
     }
-    rm->count = 0;
+    int kept = 0;
+    for (int i = 0; i < rm->count; i++)
+        if (rm->entries[i].res) rm->entries[kept++] = rm->entries[i];
+    rm->count = kept;
     rm->log.n = 0;
     rm->scope.n = 0;
 }
 
+void rm_clear(ResourceManager *rm) { drop_entries(rm, true); }
+
 void rm_destroy(ResourceManager *rm)
 {
     if (!rm) return;
-    rm_clear(rm);
+    drop_entries(rm, false);
     for (int d = 0; d < RM_MAX_DEPTH; d++) free(rm->frames[d].deps.v);
     free(rm->entries);
     free(rm->log.ev);
@@ -77,11 +101,30 @@ static void int_list_add_unique(IntList *l, int v)
     l->v[l->n++] = v;
 }
 
-/* One event per resource per list: later requests add nothing. */
-static bool event_add(EventList *l, const Entry *e, const char *desc, bool built)
+/* A resource acquired for a G-buffer, set-up or evaluation build is for that
+ * too; for a frame build it is of its own kind's category. */
+static ResourceCategory category_in(ResourceCategory context, const ResourceKind *kind)
 {
-    for (int i = 0; i < l->n; i++)
-        if (l->ev[i].key == e->key && strcmp(l->ev[i].kind, e->kind->name) == 0) return false;
+    return context != RES_FRAME ? context : kind->category;
+}
+
+static ResourceCategory current_context(const ResourceManager *rm)
+{
+    return rm->depth > 0 ? rm->frames[rm->depth - 1].context : RES_FRAME;
+}
+
+/* One event per resource per list: later requests add nothing, but a frame
+ * that needs what it had seen only as another's dependency pays for it.
+ * True when the event is new or became a frame one. */
+static bool event_add(EventList *l, const Entry *e, const char *desc, bool built, ResourceCategory category)
+{
+    for (int i = 0; i < l->n; i++) {
+        ResourceEvent *ev = &l->ev[i];
+        if (ev->key != e->key || strcmp(ev->kind, e->kind->name) != 0) continue;
+        if (category != RES_FRAME || ev->category == RES_FRAME) return false;
+        ev->category = RES_FRAME;
+        return true;
+    }
     ResourceEvent *events = array_room(l->ev, l->n, &l->cap, sizeof *events, 16);
     if (!events) return false;
     l->ev = events;
@@ -93,16 +136,23 @@ static bool event_add(EventList *l, const Entry *e, const char *desc, bool built
     ev->build_s = e->build_s;
     ev->own_s = e->own_s;
     ev->bytes = e->bytes;
+    ev->category = category;
+    ev->builds = e->builds;
+    ev->cold_own_s = e->cold_own_s;
     return true;
 }
 
 /* Record entry `i` in the open scope with, when newly recorded, the entries
- * it was built from (reused here even if this run never asked for them). */
-static void scope_add(ResourceManager *rm, int i, bool built)
+ * it was built from (reused here even if this run never asked for them), as
+ * needed for what `i` is needed for. */
+static void scope_add(ResourceManager *rm, int i, bool built, ResourceCategory category)
 {
     const Entry *e = &rm->entries[i];
-    if (!event_add(&rm->scope, e, e->desc, built)) return;
-    for (int d = 0; d < e->deps.n; d++) scope_add(rm, e->deps.v[d], false);
+    if (!event_add(&rm->scope, e, e->desc, built, category)) return;
+    for (int d = 0; d < e->deps.n; d++) {
+        int j = e->deps.v[d];
+        scope_add(rm, j, false, category_in(category, rm->entries[j].kind));
+    }
 }
 
 static int find(const ResourceManager *rm, const ResourceKind *kind, uint64_t key)
@@ -112,25 +162,35 @@ static int find(const ResourceManager *rm, const ResourceKind *kind, uint64_t ke
     return -1;
 }
 
-/* Build, time and store a new entry; its index, or -1 with err set. */
-static int build_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc,
-                       ResourceBuildFn build, const void *args, Error *err)
+/* One build in a new frame, timed: the resource (NULL + err on failure), its
+ * wall time and its own time net of the builds nested inside it. The frame
+ * stays readable (its deps) until the next build at this depth. */
+static void *timed_build(ResourceManager *rm, const ResourceKind *kind, ResourceCategory category,
+                         ResourceBuildFn build, const void *args, double *wall_s, double *own_s, Error *err)
 {
     if (rm->depth == RM_MAX_DEPTH) {
         error_set(err, "resources nested more than %d deep (building %s)", RM_MAX_DEPTH, kind->name);
-        return -1;
+        return NULL;
     }
     BuildFrame *f = &rm->frames[rm->depth++];
     f->deps.n = 0;
     f->nested_s = 0;
+    f->context = category;
     Progress prog; /* "... > shadow_map, 2.1 s" on a terminal (core/progress.h) */
     progress_begin(&prog, kind->name, 0);
     double t0 = timer_now_s();
     void *res = build(args, err);
-    double dt = timer_now_s() - t0;
+    *wall_s = timer_now_s() - t0;
     progress_end(&prog);
+    *own_s = *wall_s > f->nested_s ? *wall_s - f->nested_s : 0.0;
     rm->depth--;
-    if (!res) return -1;
+    return res;
+}
+
+/* Store a built resource; its index, or -1 with err set (and res destroyed). */
+static int store_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc, void *res,
+                       double wall_s, double own_s, Error *err)
+{
     Entry *entries = array_room(rm->entries, rm->count, &rm->cap, sizeof *entries, 16);
     if (!entries) {
         kind->destroy(res);
@@ -139,11 +199,58 @@ static int build_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t k
     }
     rm->entries = entries;
     Entry *e = &rm->entries[rm->count];
-    *e = (Entry){kind, key, res, dt, dt > f->nested_s ? dt - f->nested_s : 0.0, kind->bytes(res), "", {NULL, 0, 0}};
+    *e = (Entry){kind, key, res, wall_s, own_s, kind->bytes(res), "", {NULL, 0, 0}, 1, own_s};
     snprintf(e->desc, sizeof e->desc, "%s", desc);
-    for (int i = 0; i < f->deps.n; i++) int_list_add_unique(&e->deps, f->deps.v[i]);
-    if (rm->depth > 0) rm->frames[rm->depth - 1].nested_s += dt;
+    const IntList *deps = &rm->frames[rm->depth].deps; /* the build's frame, just popped */
+    for (int i = 0; i < deps->n; i++) int_list_add_unique(&e->deps, deps->v[i]);
     return rm->count++;
+}
+
+/* Builds 2 .. rm->builds of entry i (fewer past the budget), each fresh and
+ * destroyed at once (the entry keeps the first); its times become the
+ * medians of all of them. */
+static bool rebuild_for_median(ResourceManager *rm, int i, ResourceBuildFn build, const void *args, Error *err)
+{
+    const ResourceKind *kind = rm->entries[i].kind;
+    double *wall_s = malloc(2 * sizeof(double) * (size_t)rm->builds), *own_s = wall_s + rm->builds;
+    if (!wall_s) return error_set(err, "out of memory timing %d builds of %s", rm->builds, kind->name);
+    wall_s[0] = rm->entries[i].build_s;
+    own_s[0] = rm->entries[i].own_s;
+    double total_s = wall_s[0];
+    int n = 1;
+    for (; n < rm->builds && (rm->budget_s <= 0 || total_s < rm->budget_s); n++) {
+        void *res = timed_build(rm, kind, RES_FRAME, build, args, &wall_s[n], &own_s[n], err);
+        if (!res) {
+            free(wall_s);
+            return false;
+        }
+        kind->destroy(res);
+        total_s += wall_s[n];
+    }
+    Entry *e = &rm->entries[i]; /* the rebuilds may have added entries and moved the table */
+    e->build_s = timer_median(wall_s, n);
+    e->own_s = timer_median(own_s, n);
+    e->builds = n;
+    free(wall_s);
+    return true;
+}
+
+/* Build, time and store a new entry (a frame one inside a scope rm->builds
+ * times); its index, or -1 with err set. Its whole time, rebuilds included,
+ * is nested time of the build around it and build time of the scope. */
+static int build_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc,
+                       ResourceBuildFn build, const void *args, Error *err)
+{
+    ResourceCategory category = category_in(current_context(rm), kind);
+    double t0 = timer_now_s(), wall_s, own_s;
+    void *res = timed_build(rm, kind, category, build, args, &wall_s, &own_s, err);
+    int i = res ? store_entry(rm, kind, key, desc, res, wall_s, own_s, err) : -1;
+    bool repeat = i >= 0 && rm->scoping && category == RES_FRAME && rm->builds > 1;
+    if (repeat && !rebuild_for_median(rm, i, build, args, err)) i = -1; /* the entry stays: it is sound */
+    double dt = timer_now_s() - t0;
+    if (rm->depth > 0) rm->frames[rm->depth - 1].nested_s += dt;
+    else if (rm->scoping) rm->scope_build_s += dt;
+    return i;
 }
 
 void *rm_acquire(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc,
@@ -151,10 +258,11 @@ void *rm_acquire(ResourceManager *rm, const ResourceKind *kind, uint64_t key, co
 {
     int i = find(rm, kind, key);
     bool built = i < 0;
+    ResourceCategory category = category_in(current_context(rm), kind);
     if (built && (i = build_entry(rm, kind, key, desc, build, args, err)) < 0) return NULL;
-    event_add(&rm->log, &rm->entries[i], desc, built);
+    event_add(&rm->log, &rm->entries[i], desc, built, category);
     if (rm->depth > 0) int_list_add_unique(&rm->frames[rm->depth - 1].deps, i);
-    if (rm->scoping) scope_add(rm, i, built);
+    if (rm->scoping) scope_add(rm, i, built, category);
     return rm->entries[i].res;
 }
 
@@ -172,14 +280,19 @@ void rm_log_note(ResourceManager *rm, const char *kind, uint64_t key, const char
     }
 }
 
-void rm_scope_begin(ResourceManager *rm)
+void rm_scope_begin(ResourceManager *rm, int builds, double budget_s)
 {
     rm->scoping = true;
+    rm->builds = builds > 1 ? builds : 1;
+    rm->budget_s = budget_s;
+    rm->scope_build_s = 0;
     rm->scope.n = 0;
 }
 void rm_scope_end(ResourceManager *rm) { rm->scoping = false; }
 int rm_scope_count(const ResourceManager *rm) { return rm->scope.n; }
 const ResourceEvent *rm_scope_event(const ResourceManager *rm, int i) { return &rm->scope.ev[i]; }
+double rm_scope_build_s(const ResourceManager *rm) { return rm->scope_build_s; }
+
 size_t rm_bytes(const ResourceManager *rm)
 {
     size_t b = 0;

@@ -12,11 +12,25 @@
 #include <stdint.h>
 #include "core/error.h"
 
+/* What a renderer would pay for a resource each frame (architecture.md,
+ * "Frame time"). A resource acquired while one of another category is built
+ * is of that category too (the BVH the view samples were traced with is
+ * G-buffer), unless a frame resource also acquires it directly. */
+typedef enum ResourceCategory {
+    RES_FRAME,      /* rebuilt every frame (a shadow map): in the frame time; the default */
+    RES_GBUFFER,    /* what a renderer already has (view samples, their classes): left out */
+    RES_SETUP,      /* scene-independent constant tables (tap patterns), keyed by their
+                     * parameters and kept by rm_clear, so built once: set-up, left out */
+    RES_EVALUATION, /* the lab's own measurement (the reference): never in a frame */
+} ResourceCategory;
+const char *resource_category_name(ResourceCategory c);
+
 /* What a kind of resource is and how to measure and free one. */
 typedef struct ResourceKind {
     const char *name;                  /* e.g. "embree_bvh" */
     size_t (*bytes)(const void *res);
     void (*destroy)(void *res);
+    ResourceCategory category;
 } ResourceKind;
 
 /* Builds a resource from the caller's arguments; NULL + err on failure. */
@@ -31,14 +45,18 @@ typedef struct ResourceEvent {
     double build_s;   /* time of the build that made it (also shown on reuse) */
     size_t bytes;
     double own_s;     /* build_s less the builds of resources acquired inside it */
+    ResourceCategory category; /* the kind's, or the one it was acquired for (see above) */
+    int builds;       /* build_s and own_s are the medians of this many builds (rm_scope_begin) */
+    double cold_own_s; /* own_s of the first of them */
 } ResourceEvent;
 
 typedef struct ResourceManager ResourceManager;
 
 ResourceManager *rm_create(void);
 void rm_destroy(ResourceManager *rm);
-/* Destroy every resource (and the log): later requests build afresh. A
- * sweep calls it between techniques that share nothing, to bound memory. */
+/* Destroy every resource but the set-up tables (and the log): later requests
+ * build afresh. A sweep calls it between techniques that share nothing, to
+ * bound memory; the small scene-independent tables stay, built once. */
 void rm_clear(ResourceManager *rm);
 
 /* Find or build the resource (kind, key). `desc` describes the key for the
@@ -59,11 +77,21 @@ void rm_log_note(ResourceManager *rm, const char *kind, uint64_t key, const char
  * reused, together with the resources it was built from (also when it is
  * reused and they are not asked for again), so the sum of their own_s is the
  * cost of building the stage's resources from nothing, whatever an earlier
- * stage or run already built. `built` is true for builds inside the scope. */
-void rm_scope_begin(ResourceManager *rm);
+ * stage or run already built. `built` is true for builds inside the scope.
+ * A frame resource built inside the scope is built `builds` times, each
+ * further one a fresh build destroyed at once (the first stays cached), and
+ * its build_s and own_s are their medians, so the build time a frame pays is
+ * as steady as a median evaluation; builds = 1 times the one (cold) build.
+ * With budget_s > 0 a resource's builds stop once they took budget_s (as
+ * timed evaluations do, lab.h RenderTiming). A reused resource keeps the
+ * medians of the builds that made it. */
+void rm_scope_begin(ResourceManager *rm, int builds, double budget_s);
 void rm_scope_end(ResourceManager *rm);
 int rm_scope_count(const ResourceManager *rm);
 const ResourceEvent *rm_scope_event(const ResourceManager *rm, int i);
+/* Wall time of the builds made inside the scope, every repeat and category
+ * (what the stage's own set-up is net of). */
+double rm_scope_build_s(const ResourceManager *rm);
 
 /* Totals over everything the manager holds. */
 size_t rm_bytes(const ResourceManager *rm);

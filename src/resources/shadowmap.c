@@ -47,7 +47,7 @@ static size_t map_bytes(const void *r)
     return sizeof *m + texels * (sizeof(float) + (m->triangle ? sizeof(int32_t) : 0));
 }
 
-static const ResourceKind kind_shadow_map = {"shadow_map", map_bytes, map_destroy};
+static const ResourceKind kind_shadow_map = {"shadow_map", map_bytes, map_destroy, RES_FRAME};
 
 typedef struct MapArgs {
     ResourceManager *rm;
@@ -139,7 +139,14 @@ static bool render_faces(ShadowMap *m, const MapArgs *a, const ShadowMap *under,
     return ok;
 }
 
-static void *build_map(const void *args, Error *err)
+/* ---- the light view: the map's fit, a frame resource of its own ---------- */
+
+/* Fitting to the view (fit=view, body_visible) reads the visible samples: a
+ * renderer has them in its G-buffer, so they are not charged, but the
+ * reduction over them that the fit needs (their bounds in light space, the
+ * farthest one's depth; course §3.2.1, a visibility pre-pass pulling the far
+ * plane in) is this resource's own build time, charged to the frame. */
+static void *build_light_view(const void *args, Error *err)
 {
     const MapArgs *a = args;
     const Scene *sc = a->scene;
@@ -150,6 +157,51 @@ static void *build_map(const void *args, Error *err)
         cls = vs ? res_classes(a->rm, sc, a->light_index, err) : NULL;
         if (!cls) return NULL;
     }
+    LightView *lv = malloc(sizeof *lv);
+    if (!lv) {
+        error_set(err, "out of memory");
+        return NULL;
+    }
+    if (!lightview_fit_with(sc, &sc->lights[a->light_index], a->spec.projection, a->spec.fit, a->spec.res,
+                            &a->spec.view, vs, cls, lv, err)) {
+        free(lv);
+        return NULL;
+    }
+    return lv;
+}
+static size_t light_view_bytes(const void *r) { return sizeof *(const LightView *)r; }
+static const ResourceKind kind_light_view = {"light_view", light_view_bytes, free, RES_FRAME};
+
+static uint64_t map_key(const Scene *sc, int light_index, const ShadowMapSpec *s);
+
+/* The view of a map: keyed like the map less what only its rasterization
+ * reads (depth format, layer, culling, ids), so a map's layers share it. */
+static const LightView *res_light_view(const MapArgs *a, Error *err)
+{
+    MapArgs v = *a;
+    ShadowMapSpec *s = &v.spec;
+    s->depth = RASTER_DEPTH_LINEAR;
+    s->depth_bits = 0;
+    s->layer = MAP_LAYER_FIRST;
+    s->cull = RASTER_CULL_NONE;
+    s->triangle_ids = false;
+    s->conservative = false;
+    Hasher h;
+    hash_init(&h);
+    hash_str(&h, "light view");
+    hash_u64(&h, map_key(a->scene, a->light_index, s));
+    char desc[160];
+    snprintf(desc, sizeof desc, "light %d, %d^2 %s, fit %s", a->light_index + 1, s->res,
+             map_projection_name(s->projection), map_fit_name(s->fit));
+    return rm_acquire(a->rm, &kind_light_view, hash_final(&h), desc, build_light_view, &v, err);
+}
+
+static void *build_map(const void *args, Error *err)
+{
+    const MapArgs *a = args;
+    const Scene *sc = a->scene;
+    const LightView *view = res_light_view(a, err);
+    if (!view) return NULL;
     bool cast = a->spec.projection == MAP_PROJ_LOGPSM;
     const RtScene *casters = cast ? res_bvh(a->rm, sc, RT_CASTERS, err) : NULL;
     if (cast && !casters) return NULL;
@@ -159,11 +211,7 @@ static void *build_map(const void *args, Error *err)
     if (!m) { error_set(err, "out of memory"); return NULL; }
     m->spec = a->spec;
     m->key = a->key;
-    if (!lightview_fit_with(sc, &sc->lights[a->light_index], a->spec.projection, a->spec.fit, a->spec.res,
-                            &a->spec.view, vs, cls, &m->view, err)) {
-        free(m);
-        return NULL;
-    }
+    m->view = *view;
     m->res = a->spec.res;
     m->num_faces = m->view.num_faces;
     size_t texels = (size_t)m->num_faces * (size_t)m->res * (size_t)m->res;

@@ -20,7 +20,7 @@ static size_t sw_bytes(const void *r)
     return sizeof *w + sizeof(float) * (size_t)w->num_faces * (size_t)w->res * (size_t)w->res;
 }
 
-static const ResourceKind kind_shadow_width = {"shadow_width_map", sw_bytes, sw_destroy};
+static const ResourceKind kind_shadow_width = {"shadow_width_map", sw_bytes, sw_destroy, RES_FRAME};
 
 /* The minimum as a plain select (no NaN rules: widths are finite), which
  * compilers vectorise where fminf may stay a call. */

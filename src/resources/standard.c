@@ -17,7 +17,7 @@ static void *build_bvh(const void *args, Error *err)
 }
 static size_t bvh_bytes(const void *r) { return rt_scene_bytes(r); }
 static void bvh_destroy(void *r) { rt_scene_release(r); }
-static const ResourceKind kind_bvh = {"embree_bvh", bvh_bytes, bvh_destroy};
+static const ResourceKind kind_bvh = {"embree_bvh", bvh_bytes, bvh_destroy, RES_FRAME};
 
 const RtScene *res_bvh(ResourceManager *rm, const Scene *scene, RtGeometrySet set, Error *err)
 {
@@ -52,7 +52,8 @@ static void view_destroy(void *r)
     view_samples_free(r);
     free(r);
 }
-static const ResourceKind kind_view = {"view_samples", view_bytes, view_destroy};
+/* A renderer has its G-buffer: view samples (and the BVH they were traced with) are not in the frame. */
+static const ResourceKind kind_view = {"view_samples", view_bytes, view_destroy, RES_GBUFFER};
 
 static uint64_t view_key(const Scene *scene)
 {
@@ -97,7 +98,7 @@ static void classes_destroy(void *r)
     free(((Classes *)r)->cls);
     free(r);
 }
-static const ResourceKind kind_classes = {"sample_classes", classes_bytes, classes_destroy};
+static const ResourceKind kind_classes = {"sample_classes", classes_bytes, classes_destroy, RES_GBUFFER};
 
 const uint8_t *res_classes(ResourceManager *rm, const Scene *scene, int light_index, Error *err)
 {
@@ -112,6 +113,48 @@ const uint8_t *res_classes(ResourceManager *rm, const Scene *scene, int light_in
     snprintf(desc, sizeof desc, "light %d (%s)", light_index + 1, light_kind_name(scene->lights[light_index].kind));
     const Classes *c = rm_acquire(rm, &kind_classes, hash_final(&h), desc, build_classes, &a, err);
     return c ? c->cls : NULL;
+}
+
+/* ---- constant point tables ---------------------------------------------- */
+
+typedef struct TableArgs { PointTableFill fill; int n; } TableArgs;
+
+static void *build_table(const void *args, Error *err)
+{
+    const TableArgs *a = args;
+    PointTable *t = malloc(sizeof *t);
+    if (t) t->pts = malloc(sizeof *t->pts * (size_t)a->n);
+    if (!t || !t->pts) {
+        free(t);
+        error_set(err, "out of memory for a table of %d points", a->n);
+        return NULL;
+    }
+    t->n = a->n;
+    a->fill(t->pts, a->n);
+    return t;
+}
+static size_t table_bytes(const void *r) { return sizeof(float[2]) * (size_t)((const PointTable *)r)->n; }
+static void table_destroy(void *r)
+{
+    free(((PointTable *)r)->pts);
+    free(r);
+}
+static const ResourceKind kind_table = {"point_table", table_bytes, table_destroy, RES_SETUP};
+
+const PointTable *res_point_table(ResourceManager *rm, const char *generator, PointTableFill fill, int n, Error *err)
+{
+    if (n < 1) {
+        error_set(err, "%s: %d points; at least 1", generator, n);
+        return NULL;
+    }
+    Hasher h;
+    hash_init(&h);
+    hash_str(&h, generator);
+    hash_u64(&h, (uint64_t)n);
+    TableArgs a = {fill, n};
+    char desc[160];
+    snprintf(desc, sizeof desc, "%s, %d points", generator, n);
+    return rm_acquire(rm, &kind_table, hash_final(&h), desc, build_table, &a, err);
 }
 
 /* ---- references --------------------------------------------------------- */
@@ -205,7 +248,7 @@ static void ref_destroy(void *r)
     reference_free(r);
     free(r);
 }
-static const ResourceKind kind_reference = {"reference", ref_bytes, ref_destroy};
+static const ResourceKind kind_reference = {"reference", ref_bytes, ref_destroy, RES_EVALUATION};
 
 const Reference *res_reference(ResourceManager *rm, const Scene *scene, const RefRequest *req, RefInfo *info,
                                Error *err)

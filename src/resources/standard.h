@@ -11,6 +11,14 @@ const RtScene *res_bvh(ResourceManager *rm, const Scene *scene, RtGeometrySet se
 const ViewSamples *res_view_samples(ResourceManager *rm, const Scene *scene, Error *err);
 const uint8_t *res_classes(ResourceManager *rm, const Scene *scene, int light_index, Error *err);
 
+/* A scene-independent table of n points (a tap pattern, a Poisson disk),
+ * made by fill(pts, n) with the generator's own fixed seed and keyed by the
+ * generator's name (which names that seed) and n: a set-up resource, built
+ * once per manager whatever the sweep and left out of the frame. */
+typedef struct PointTable { int n; float (*pts)[2]; } PointTable;
+typedef void (*PointTableFill)(float (*pts)[2], int n);
+const PointTable *res_point_table(ResourceManager *rm, const char *generator, PointTableFill fill, int n, Error *err);
+
 /* Where a reference came from. */
 typedef enum RefOrigin { REF_COMPUTED, REF_CACHE_HIT, REF_CACHE_CORRUPT_RECOMPUTED, REF_REUSED } RefOrigin;
 const char *ref_origin_name(RefOrigin o);

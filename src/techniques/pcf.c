@@ -7,6 +7,7 @@
  * the disk, and all of them only where those disagree (the penumbra). */
 #include <stdlib.h>
 #include "core/hash.h"
+#include "resources/standard.h"
 #include "techniques/smap.h"
 
 enum { KERNEL_BOX, KERNEL_BILINEAR, KERNEL_POISSON, KERNEL_ADAPTIVE };
@@ -29,14 +30,14 @@ static const ParamDesc pcf_params[] = {
     {"rotate", PARAM_BOOL, 1, 0, 1, "", "poisson and adaptive: rotate the disk per pixel (banding becomes noise)", NULL},
 };
 
-static const char *const pcf_resources[] = {"shadow_map", "view_samples", NULL};
+static const char *const pcf_resources[] = {"shadow_map", "view_samples", "point_table", NULL};
 
 typedef struct PcfState {
     const ShadowMap *map;
     SmapBias bias;
     int K, kernel, samples, initial;
     bool rotate;
-    float disk[PCF_MAX_SAMPLES][2]; /* unit disk, progressive: every prefix is well spread */
+    const PointTable *disk; /* unit disk, progressive: every prefix is well spread (a set-up table) */
 } PcfState;
 
 /* Mitchell's best-candidate points in the unit disk: each new point is the
@@ -79,7 +80,14 @@ static bool pcf_prepare(const TechContext *ctx, void **state, Error *err)
     st->samples = (int)p[P_SAMPLES];
     st->initial = (int)p[P_INITIAL] < st->samples ? (int)p[P_INITIAL] : st->samples;
     st->rotate = p[P_ROTATE] != 0.0;
-    if (st->kernel >= KERNEL_POISSON) poisson_disk(st->disk, st->samples);
+    st->disk = NULL;
+    if (st->kernel >= KERNEL_POISSON) {
+        st->disk = res_point_table(ctx->rm, "pcf best-candidate disk", poisson_disk, st->samples, err);
+        if (!st->disk) {
+            free(st);
+            return false;
+        }
+    }
     *state = st;
     return true;
 }
@@ -136,7 +144,7 @@ static int disk_lit(const PcfState *st, const SmapReceiver *r, int first, int la
     double radius = 0.5 * st->K;
     int lit = 0;
     for (int k = first; k < last; k++) {
-        double x = st->disk[k][0], y = st->disk[k][1];
+        double x = st->disk->pts[k][0], y = st->disk->pts[k][1];
         double s = r->mc.s + radius * (cs * x - sn * y), t = r->mc.t + radius * (sn * x + cs * y);
         lit += smap_lit(st->map, r, (int)floor(s), (int)floor(t)) > 0.0f;
     }

@@ -16,6 +16,7 @@
  * to a square light is the exact box convolution, catalogue §5.2.2), by a
  * regular grid of taps, or by a Poisson disk rotated per pixel. */
 #include <stdlib.h>
+#include "resources/standard.h"
 #include "techniques/softmap.h"
 
 enum { SAMPLING_POISSON, SAMPLING_REGULAR, SAMPLING_EXHAUSTIVE };
@@ -44,12 +45,12 @@ static const ParamDesc pcss_params[] = {
      NULL},
 };
 
-static const char *const pcss_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", NULL};
+static const char *const pcss_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", "point_table", NULL};
 
 /* A tap pattern on [-1, 1]^2: a regular side x side grid or a Poisson disk. */
 typedef struct Pattern {
     int taps, side;
-    float (*disk)[2];
+    const PointTable *disk; /* Poisson sampling: a set-up table; NULL otherwise */
 } Pattern;
 
 typedef struct PcssState {
@@ -59,15 +60,14 @@ typedef struct PcssState {
     bool rotate;
     double max_radius;
     Pattern search, filter;
-    float disk[2][SOFTMAP_MAX_POISSON][2];
 } PcssState;
 
-static void pattern_init(Pattern *p, int sampling, int taps, float (*disk)[2])
+static bool pattern_init(Pattern *p, ResourceManager *rm, int sampling, int taps, Error *err)
 {
     p->side = (int)lround(sqrt((double)taps));
     p->taps = sampling == SAMPLING_REGULAR ? p->side * p->side : taps;
-    p->disk = disk;
-    if (sampling == SAMPLING_POISSON) softmap_poisson(disk, taps);
+    p->disk = sampling == SAMPLING_POISSON ? res_point_table(rm, "softmap poisson disk", softmap_poisson, taps, err) : NULL;
+    return sampling != SAMPLING_POISSON || p->disk;
 }
 
 static bool pcss_prepare(const TechContext *ctx, void **state, Error *err)
@@ -85,8 +85,11 @@ static bool pcss_prepare(const TechContext *ctx, void **state, Error *err)
     st->sampling = (int)p[P_SAMPLING];
     st->rotate = p[P_ROTATE] != 0.0 && st->sampling == SAMPLING_POISSON;
     st->max_radius = p[P_MAX_RADIUS];
-    pattern_init(&st->search, st->sampling, (int)p[P_BLOCKER_TAPS], st->disk[0]);
-    pattern_init(&st->filter, st->sampling, (int)p[P_FILTER_TAPS], st->disk[1]);
+    if (!pattern_init(&st->search, ctx->rm, st->sampling, (int)p[P_BLOCKER_TAPS], err) ||
+        !pattern_init(&st->filter, ctx->rm, st->sampling, (int)p[P_FILTER_TAPS], err)) {
+        free(st);
+        return false;
+    }
     *state = st;
     return true;
 }
@@ -99,7 +102,7 @@ static void tap(const Pattern *p, bool regular, int k, double cs, double sn, dou
         *y = -1.0 + (2.0 * (k / p->side) + 1.0) / p->side;
         return;
     }
-    double px = p->disk[k][0], py = p->disk[k][1];
+    double px = p->disk->pts[k][0], py = p->disk->pts[k][1];
     *x = cs * px - sn * py;
     *y = sn * px + cs * py;
 }

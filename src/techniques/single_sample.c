@@ -57,7 +57,7 @@ static void *build_outer(const void *args, Error *err)
 }
 static size_t outer_bytes(const void *r) { return outer_scene_bytes(r); }
 static void outer_destroy(void *r) { outer_scene_release(r); }
-static const ResourceKind kind_outer = {"outer_objects", outer_bytes, outer_destroy};
+static const ResourceKind kind_outer = {"outer_objects", outer_bytes, outer_destroy, RES_FRAME};
 
 /* Keyed by exactly its inputs: the caster triangles and, when used, the
  * analytic spheres. Not the light: b is formed per ray, so a sweep of the

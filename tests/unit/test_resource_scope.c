@@ -3,7 +3,12 @@
  * never asks for again, and the own build times of those resources add up to
  * the cost of building them from nothing; a technique's frame time (lab.h)
  * is the same whether its resources were built in this run or reused; a time
- * budget stops the timed repeats and the result says how many ran. */
+ * budget stops the timed repeats and the result says how many ran. Frame
+ * time on map techniques: fit=view charges the fit's reduction, not the view
+ * samples (the G-buffer); a constant table is set-up, built once across a
+ * sweep; the frame resources' builds are repeated with the evaluations and
+ * their median reported. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -11,13 +16,19 @@
 #include "lab/compare.h"
 #include "test.h"
 
-/* A fake resource: sleeps `ms`, then optionally acquires a dependency. */
+/* A fake resource: sleeps `ms`, then optionally acquires a dependency;
+ * builds and destroys are counted. */
 typedef struct Fake { int id; } Fake;
 typedef struct FakeArgs { ResourceManager *rm; int id; int ms; int dep_id; int dep_ms; } FakeArgs;
+static int fake_builds, fake_destroys;
 
 static size_t fake_bytes(const void *r) { (void)r; return sizeof(Fake); }
-static void fake_destroy(void *r) { free(r); }
-static const ResourceKind kind_fake = {"fake", fake_bytes, fake_destroy};
+static void fake_destroy(void *r)
+{
+    fake_destroys++;
+    free(r);
+}
+static const ResourceKind kind_fake = {"fake", fake_bytes, fake_destroy, RES_FRAME};
 
 static void sleep_ms(int ms)
 {
@@ -30,6 +41,7 @@ static const Fake *acquire_fake(ResourceManager *rm, int id, int ms, int dep_id,
 static void *build_fake(const void *args, Error *err)
 {
     const FakeArgs *a = args;
+    fake_builds++;
     sleep_ms(a->ms);
     if (a->dep_id >= 0 && !acquire_fake(a->rm, a->dep_id, a->dep_ms, -1, 0, err)) return NULL;
     Fake *f = malloc(sizeof *f);
@@ -57,7 +69,7 @@ TEST(test_scope_names_dependencies_of_reused_resources)
     Error err;
     ResourceManager *rm = rm_create();
     /* Stage 1 builds 2, which builds its dependency 1 inside its own build. */
-    rm_scope_begin(rm);
+    rm_scope_begin(rm, 1, 0.0);
     CHECK(acquire_fake(rm, 2, 30, 1, 20, &err));
     rm_scope_end(rm);
     CHECK(rm_scope_count(rm) == 2);
@@ -70,14 +82,14 @@ TEST(test_scope_names_dependencies_of_reused_resources)
               outer->build_s);
     double cost_built = outer->own_s + inner->own_s;
     /* Stage 2 reuses 2 and never asks for 1: the scope still lists 1. */
-    rm_scope_begin(rm);
+    rm_scope_begin(rm, 1, 0.0);
     CHECK(acquire_fake(rm, 2, 30, 1, 20, &err));
     rm_scope_end(rm);
     CHECK(rm_scope_count(rm) == 2);
     CHECK(!scope_find(rm, 2)->built && !scope_find(rm, 1)->built);
     CHECK_NEAR(scope_find(rm, 2)->own_s + scope_find(rm, 1)->own_s, cost_built, 1e-12);
     /* Acquisitions outside a scope are not recorded in it. */
-    rm_scope_begin(rm);
+    rm_scope_begin(rm, 1, 0.0);
     rm_scope_end(rm);
     CHECK(acquire_fake(rm, 3, 0, -1, 0, &err));
     CHECK(rm_scope_count(rm) == 0);
@@ -156,5 +168,158 @@ TEST(test_time_budget_stops_timed_repeats_and_says_how_many_ran)
     render_result_free(&tiny);
     RenderTiming negative = {1, -1.0};
     CHECK(!lab_render_timed(lab, &rq, &negative, &tiny, &err) && strstr(err.msg, "budget"));
+    lab_close(lab);
+}
+
+TEST(test_scope_builds_frame_resources_repeatedly_and_reports_the_median)
+{
+    Error err;
+    ResourceManager *rm = rm_create();
+    fake_builds = fake_destroys = 0;
+    /* 2 builds its dependency 1: each is built 3 times, 1 inside 2's first build */
+    rm_scope_begin(rm, 3, 0.0);
+    const Fake *f = acquire_fake(rm, 2, 1, 1, 1, &err);
+    rm_scope_end(rm);
+    CHECK(f && f->id == 2);
+    CHECK_MSG(fake_builds == 6 && fake_destroys == 4, "builds %d destroys %d", fake_builds, fake_destroys);
+    CHECK(scope_find(rm, 2)->builds == 3 && scope_find(rm, 1)->builds == 3);
+    CHECK(scope_find(rm, 2)->category == RES_FRAME);
+    /* the cached value is the first build's; a later scope reuses it and its medians */
+    rm_scope_begin(rm, 3, 0.0);
+    CHECK(acquire_fake(rm, 2, 1, 1, 1, &err) == f);
+    rm_scope_end(rm);
+    CHECK(fake_builds == 6 && scope_find(rm, 2)->builds == 3 && !scope_find(rm, 2)->built);
+    /* one build per resource with builds = 1, and outside a scope */
+    rm_scope_begin(rm, 1, 0.0);
+    CHECK(acquire_fake(rm, 3, 0, -1, 0, &err));
+    rm_scope_end(rm);
+    CHECK(acquire_fake(rm, 4, 0, -1, 0, &err));
+    CHECK(fake_builds == 8 && scope_find(rm, 3)->builds == 1);
+    /* a budget every build exceeds (1 ns): the first build is the one timed */
+    rm_scope_begin(rm, 5, 1e-9);
+    CHECK(acquire_fake(rm, 5, 0, -1, 0, &err));
+    rm_scope_end(rm);
+    CHECK(fake_builds == 9 && scope_find(rm, 5)->builds == 1);
+    rm_destroy(rm);
+}
+
+static bool set_params(const Technique *t, const char *const *assignments, double *params, Error *err)
+{
+    tech_params_default(t, params);
+    for (; *assignments; assignments++)
+        if (!tech_param_parse(t, *assignments, params, err)) return false;
+    return true;
+}
+
+static bool compare_tech(Lab *lab, const char *name, const char *const *assignments, int repeat, CompareResult *out)
+{
+    Error err;
+    static double params[TECH_MAX_PARAMS];
+    const Technique *t = tech_find(name, &err);
+    if (!t || !set_params(t, assignments, params, &err)) return false;
+    CompareRequest rq = {t, params, 0, repeat, 0, false, {MEASURE_VISIBILITY, 16, SAMPLING_R2, 1}, NULL, 0.0};
+    return lab_compare(lab, &rq, out, &err);
+}
+
+static const ResourceEvent *tech_event(const RenderResult *r, const char *kind)
+{
+    for (int i = 0; i < r->num_tech_resources; i++)
+        if (strcmp(r->tech_resources[i].kind, kind) == 0) return &r->tech_resources[i];
+    return NULL;
+}
+
+/* frame = frame resources' own builds + the prepare's own set-up + median evaluation (lab.h) */
+static bool frame_adds_up(const RenderResult *r)
+{
+    double frame = 0, gbuffer = 0, setup = 0;
+    for (int i = 0; i < r->num_tech_resources; i++) {
+        const ResourceEvent *ev = &r->tech_resources[i];
+        frame += ev->category == RES_FRAME ? ev->own_s : 0.0;
+        gbuffer += ev->category == RES_GBUFFER ? ev->own_s : 0.0;
+        setup += ev->category == RES_SETUP ? ev->own_s : 0.0;
+    }
+    return fabs(frame - r->tech_build_s) < 1e-12 && fabs(gbuffer - r->gbuffer_s) < 1e-12 &&
+           fabs(setup - r->setup_s) < 1e-12 &&
+           fabs(r->frame_s - (r->tech_build_s + r->prepare_own_s + r->eval_median_s)) < 1e-12;
+}
+
+TEST(test_fit_view_frame_time_charges_the_reduction_not_the_view_samples)
+{
+    Lab *lab = fixture_lab("fitview.lua", scope_scene);
+    CHECK(lab);
+    const char *const fit_view[] = {"fit=view", "map_size=128", NULL};
+    CompareResult c;
+    CHECK(compare_tech(lab, "sm", fit_view, 1, &c));
+    const RenderResult *r = &c.render;
+    /* the map reads the view samples, their classes and (through them) the BVH: a renderer's G-buffer */
+    const char *const gbuffer[] = {"view_samples", "sample_classes", "embree_bvh"};
+    for (int i = 0; i < 3; i++) {
+        const ResourceEvent *ev = tech_event(r, gbuffer[i]);
+        CHECK_MSG(ev && ev->category == RES_GBUFFER, "%s: %s", gbuffer[i], ev ? resource_category_name(ev->category) : "absent");
+    }
+    /* the fit (the reduction over the visible samples) and the map are the frame's */
+    const ResourceEvent *view = tech_event(r, "light_view"), *map = tech_event(r, "shadow_map");
+    CHECK(view && view->built && view->category == RES_FRAME);
+    CHECK(map && map->built && map->category == RES_FRAME);
+    CHECK(r->gbuffer_s > 0 && frame_adds_up(r));
+    compare_result_free(&c);
+    lab_close(lab);
+}
+
+TEST(test_constant_tables_are_set_up_built_once_across_a_sweep)
+{
+    Lab *lab = fixture_lab("tables.lua", scope_scene);
+    CHECK(lab);
+    ResourceManager *rm = lab_resources(lab);
+    const char *const k3[] = {"kernel=poisson", "samples=64", "K=3", "map_size=128", NULL};
+    const char *const k5[] = {"kernel=poisson", "samples=64", "K=5", "map_size=128", NULL};
+    const char *const map_size[] = {"kernel=poisson", "samples=64", "K=5", "map_size=64", NULL};
+    CompareResult c;
+    for (int run = 0; run < 3; run++) {
+        if (run == 2) rm_clear(rm); /* a sweep dropping its resources between techniques */
+        CHECK(compare_tech(lab, "pcf", run == 0 ? k3 : run == 1 ? k5 : map_size, 1, &c));
+        const ResourceEvent *disk = tech_event(&c.render, "point_table");
+        CHECK_MSG(disk && disk->category == RES_SETUP && disk->built == (run == 0), "run %d: disk %s", run,
+                  disk ? (disk->built ? "built" : "reused") : "absent");
+        CHECK(c.render.setup_s > 0 && frame_adds_up(&c.render));
+        int logged = 0; /* the run's resource log says the same */
+        for (int i = 0; i < rm_log_count(rm); i++) {
+            const ResourceEvent *ev = rm_log_event(rm, i);
+            if (strcmp(ev->kind, "point_table") == 0) logged += ev->built == (run == 0) ? 1 : 100;
+        }
+        CHECK(logged == 1);
+        compare_result_free(&c);
+    }
+    /* pcss's search and filter patterns (16 Poisson taps each): one set-up table of its own generator */
+    const char *const pcss[] = {"map_size=64", NULL};
+    CHECK(compare_tech(lab, "pcss", pcss, 1, &c));
+    int tables = 0;
+    for (int i = 0; i < c.render.num_tech_resources; i++) {
+        const ResourceEvent *ev = &c.render.tech_resources[i];
+        if (strcmp(ev->kind, "point_table") == 0) tables += ev->category == RES_SETUP && ev->built ? 1 : 100;
+    }
+    CHECK(tables == 1 && frame_adds_up(&c.render));
+    compare_result_free(&c);
+    lab_close(lab);
+}
+
+TEST(test_frame_builds_are_repeated_with_the_evaluations)
+{
+    Lab *lab = fixture_lab("repeat.lua", scope_scene);
+    CHECK(lab);
+    const char *const fit_view[] = {"fit=view", "map_size=64", NULL};
+    const char *const fit_view_other[] = {"fit=view", "map_size=32", NULL};
+    CompareResult c;
+    CHECK(compare_tech(lab, "sm", fit_view, 3, &c));
+    const ResourceEvent *map = tech_event(&c.render, "shadow_map"), *view = tech_event(&c.render, "light_view");
+    CHECK(map && view && map->builds == 3 && view->builds == 3 && c.render.repeat == 3);
+    CHECK(tech_event(&c.render, "view_samples")->builds == 1); /* the G-buffer is not rebuilt */
+    CHECK(frame_adds_up(&c.render));
+    compare_result_free(&c);
+    /* --repeat 1: one build, its time reported */
+    CHECK(compare_tech(lab, "sm", fit_view_other, 1, &c));
+    map = tech_event(&c.render, "shadow_map");
+    CHECK(map && map->built && map->builds == 1 && map->own_s == map->cold_own_s);
+    compare_result_free(&c);
     lab_close(lab);
 }
