@@ -300,13 +300,19 @@ function Experiment:open_results(o, configs)
   return records.open(jsonl, csv, header, function(row) return row.status == "ok" end), header
 end
 
-local function image_paths(config)
+-- A configuration's images, in a folder named by its key; the reference's in
+-- one named by everything the reference depends on (the scene's content, the
+-- light, samples, pattern, seed), so a --fresh run with other samples never
+-- shows an older reference under its caption.
+function Experiment:image_paths(config)
   local dir = "images/" .. config.key
   local t = config.entry.technique.name
+  local ref = "images/ref-" .. sl.hash(json.encode({ scene = config.variant.info.hash, light = self.light,
+                                                      samples = self.samples, pattern = self.pattern or json.null,
+                                                      seed = self.seed or json.null }))
   return { dir = dir, visibility = dir .. "/" .. t .. ".png", shaded = dir .. "/" .. t .. "-shaded.png",
            error = dir .. "/" .. t .. "-error.png",
-           reference = "images/ref-" .. config.variant.info.hash .. "/reference.png",
-           reference_shaded = "images/ref-" .. config.variant.info.hash .. "/reference-shaded.png" }
+           reference = ref .. "/reference.png", reference_shaded = ref .. "/reference-shaded.png" }
 end
 
 function Experiment:compare_options(config, out_dir)
@@ -317,7 +323,7 @@ end
 
 -- The reference's images for a variant, once per results folder.
 function Experiment:reference_images(config, out)
-  local paths = image_paths(config)
+  local paths = self:image_paths(config)
   if exists(out .. "/" .. paths.reference) then return end
   config.variant.lab:reference{ light = self.light, samples = self.samples, pattern = self.pattern,
                                 seed = self.seed, cache = self.cache, exr = false,
@@ -329,7 +335,7 @@ function Experiment:run_one(config, o, header)
                 technique = config.entry.technique.name, params = config.entry.params,
                 variant = { scene = config.variant.info.name, file = config.variant.file,
                             overrides = config.variant.overrides, label = config.variant.label } }
-  local paths = o.images and image_paths(config) or nil
+  local paths = o.images and self:image_paths(config) or nil
   local ok, run = pcall(function()
     local r = config.variant.lab:compare(self:compare_options(config, paths and o.out .. "/" .. paths.dir))
     if paths then self:reference_images(config, o.out) end

@@ -108,6 +108,15 @@ if grep -q "reference 16 samples, noise rms" "$FULL/plots/error-vs-time-sphere-o
     ok plot_states_scene_resolution_samples_noise
 else no plot_states_scene_resolution_samples_noise "title"; fi
 
+# ---- --fresh with other reference samples shows the new reference, not the old one under a new caption
+"$SL" run "$SWEEP" --out "$TMP/refs" --samples 4 --quiet >/dev/null 2>&1
+grep -o 'images/ref-[0-9a-f]*/reference.png' "$TMP/refs/index.html" | sort -u >"$TMP/refs-before"
+"$SL" run "$SWEEP" --out "$TMP/refs" --fresh --samples 8 --quiet >/dev/null 2>&1
+grep -o 'images/ref-[0-9a-f]*/reference.png' "$TMP/refs/index.html" | sort -u >"$TMP/refs-after"
+if [ -s "$TMP/refs-before" ] && [ -s "$TMP/refs-after" ] && [ -z "$(comm -12 "$TMP/refs-before" "$TMP/refs-after")" ]; then
+    ok fresh_run_with_other_samples_shows_its_own_reference
+else no fresh_run_with_other_samples_shows_its_own_reference "$(cat "$TMP/refs-before" "$TMP/refs-after" | tr '\n' ' ')"; fi
+
 # ---- killed with SIGKILL mid-way, a torn last row, then --resume
 KILLED=$TMP/killed
 SHADOWLAB_TEST_ROW_DELAY=0.5 "$SL" run "$SWEEP" --out "$KILLED" --quiet >/dev/null 2>&1 &
