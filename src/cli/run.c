@@ -4,6 +4,7 @@
 #include <omp.h>
 #include <string.h>
 #include "cli/cli.h"
+#include "core/hash.h"
 #include "core/progress.h"
 #include "lab/compare.h"
 #include "resources/refcache.h"
@@ -58,13 +59,25 @@ static bool setup(Job *j, int stages, Error *err)
     return true;
 }
 
+/* -o DIR, else reports/SCENE-NAME for the scene as its file says, and
+ * reports/SCENE-NAME-HASH (8 hex digits of the scene's content hash) under
+ * -s overrides: outputs of different scene states never share a folder (a
+ * reference of radius 0.4 beside a technique's image of radius 0.1). */
+static void default_out_dir(Job *j, const Scene *sc)
+{
+    char hex[17];
+    hash_hex(sc->hash, hex);
+    if (j->o.out_dir) snprintf(j->out_dir, sizeof j->out_dir, "%s", j->o.out_dir);
+    else if (j->o.num_overrides == 0) snprintf(j->out_dir, sizeof j->out_dir, "reports/%s", sc->name);
+    else snprintf(j->out_dir, sizeof j->out_dir, "reports/%s-%.8s", sc->name, hex);
+}
+
 static bool load(Job *j, Error *err)
 {
     j->lab = lab_open(j->o.scene, j->o.overrides, j->o.num_overrides, err);
     if (!j->lab) return false;
     const Scene *sc = lab_scene(j->lab);
-    if (j->o.out_dir) snprintf(j->out_dir, sizeof j->out_dir, "%s", j->o.out_dir);
-    else snprintf(j->out_dir, sizeof j->out_dir, "reports/%s", sc->name);
+    default_out_dir(j, sc);
     if (j->o.cache_dir) snprintf(j->cache_dir, sizeof j->cache_dir, "%s", j->o.cache_dir);
     else refcache_default_dir(j->cache_dir, sizeof j->cache_dir);
     j->req.cache_dir = j->o.no_cache ? NULL : j->cache_dir;

@@ -236,5 +236,18 @@ expect demo_fails_loudly_naming_the_run 1 "FAILED: hard" -- \
 if [ -e "$TMP/demo-fail/metrics.md" ]; then no demo_failure_writes_no_metrics_table "metrics.md written"
 else ok demo_failure_writes_no_metrics_table; fi
 
+# Default output folders: the scene as its file says in reports/NAME, under -s overrides in
+# reports/NAME-HASH, so a reference and a technique of different scene states never share one.
+mkdir -p "$TMP/outdirs"
+(cd "$TMP/outdirs" && "$SL" reference "$ROOT/scenes/sphere-on-plane.lua" -n 4 -s camera.width=16 -s camera.height=12 \
+    >/dev/null 2>&1 && "$SL" compare "$ROOT/scenes/sphere-on-plane.lua" -t hard -n 4 -s camera.width=16 \
+    -s camera.height=12 -s 'lights[1].radius=0.1' >/dev/null 2>&1)
+dirs=$(ls "$TMP/outdirs/reports" 2>/dev/null | tr '\n' ' ')
+mixed=0
+for d in "$TMP/outdirs/reports"/*; do [ -e "$d/reference.json" ] && [ -e "$d/hard.json" ] && mixed=1; done
+if [ "$(ls "$TMP/outdirs/reports" 2>/dev/null | grep -c '^sphere-on-plane-[0-9a-f]\{8\}$')" -eq 2 ] && [ "$mixed" -eq 0 ]; then
+    ok outputs_of_different_scene_states_do_not_share_a_folder
+else no outputs_of_different_scene_states_do_not_share_a_folder "folders: $dirs"; fi
+
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
