@@ -8,7 +8,7 @@
 -- ray-traced truth (one exact shadow ray per sample for the sun). Time: the
 -- frame time (the maps rebuilt every frame, then the lookups: lab.h).
 --   build/shadowlab run experiments/terrain-error-vs-time.lua [--sizes 1024,2048,4096] [--out DIR]
---       [--repeats N] [-s camera.width=W ...] [--no-images]
+--       [--repeat N] [-s camera.width=W ...] [--no-images]
 -- Each (map size, scheme) group runs as its own experiment (its maps are
 -- freed before the next: 8 cascades of 4096^2 are 512 MiB), under
 -- DIR/<size>-<scheme>/ (default DIR reports/terrain-error-vs-time); then

@@ -121,7 +121,7 @@ experiment options:
   --mixed-builds   let --resume add rows of this build (commit, CPU, threads) beside rows of another
   --shard I/N      run only configurations whose index modulo N is I (0 <= I < N), into their own files
   --threads N      worker threads
-  --repeats N      timed evaluations per configuration (median and minimum recorded)
+  --repeat N       timed evaluations per configuration (median and minimum recorded)
   --warmup N       untimed evaluations before them
   --samples N      reference light samples per view sample
   -s, --set K=V    scene override for every scene, e.g. --set camera.width=160 (repeatable)
@@ -184,7 +184,7 @@ function experiment.parse_args(argv, extra)
       o.shard = { index = si, count = sn }
       i = i + 1
     elseif a == "--threads" then o.threads = int_arg(argv, i, a, 1, 1024); i = i + 1
-    elseif a == "--repeats" then o.repeats = int_arg(argv, i, a, 1, 10000); i = i + 1
+    elseif a == "--repeat" then o.repeats = int_arg(argv, i, a, 1, 10000); i = i + 1
     elseif a == "--warmup" then o.warmup = int_arg(argv, i, a, 0, 1000); i = i + 1
     elseif a == "--samples" then o.samples = int_arg(argv, i, a, 1, 1048576); i = i + 1
     elseif a == "--help" or a == "-h" then io.stdout:write(usage, extra_usage(extra), "\n"); os.exit(0)

@@ -81,7 +81,7 @@ expect script_result_is_the_exit_status 3 -- "$SL" run tests/lua/bad/returns.lua
 for kind in string float big; do
     expect "script_returning_a_${kind}_fails" 1 "not an exit status" -- "$SL" run tests/lua/bad/returns.lua "$kind"
 done
-expect run_help_lists_every_experiment_option 0 --out --resume --fresh --mixed-builds --shard --threads --repeats --warmup \
+expect run_help_lists_every_experiment_option 0 --out --resume --fresh --mixed-builds --shard --threads --repeat --warmup \
     --samples --set --no-images --quiet -- "$SL" run --help
 expect experiment_unknown_argument 2 "unknown argument '--frob'" -- "$SL" run "$SWEEP" --frob
 expect experiment_bad_shard 2 "--shard expects I/N" -- "$SL" run "$SWEEP" --shard 2/2
@@ -207,7 +207,7 @@ grep -q "mixed builds" "$TMP/stale/index.html" && ok report_names_mixed_builds |
     no report_names_mixed_builds "index.html has no 'mixed builds'"
 
 # ---- the shipped experiments at tiny settings (the default runs are the README's)
-TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeats 1 --warmup 0 --no-images"
+TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeat 1 --warmup 0 --no-images"
 expect error_vs_time_runs 0 "report:" -- "$SL" run experiments/error-vs-time.lua --factors 1 $TINY --out "$TMP/evt"
 expect error_vs_time_plot_shows_every_registered_technique 0 "every registered technique" -- \
     "$SL" run tests/lua/every-technique.lua "$TMP/evt"
