@@ -92,6 +92,11 @@ FULL=$TMP/full
 expect sweep_runs_and_reports 0 "6 computed" "report:" -- "$SL" run "$SWEEP" --out "$FULL"
 [ "$(rows "$FULL/records.jsonl")" -eq 6 ] && ok sweep_records_six_rows || no sweep_records_six_rows "$(rows "$FULL/records.jsonl") rows"
 [ "$(wc -l <"$FULL/results.csv")" -eq 7 ] && ok sweep_csv_has_a_line_per_row || no sweep_csv_has_a_line_per_row "csv"
+missing=""
+for c in reference_pattern reference_seed reference_measure reference_rays supersample cpu commit threads; do
+    head -1 "$FULL/results.csv" | tr ',' '\n' | grep -qx "$c" || missing="$missing $c"
+done
+[ -z "$missing" ] && ok sweep_csv_says_how_it_was_measured || no sweep_csv_says_how_it_was_measured "lacks$missing"
 expect sweep_refuses_to_overwrite 1 "--resume" -- "$SL" run "$SWEEP" --out "$FULL" --quiet
 expect sweep_resume_of_a_finished_run_computes_nothing 0 "0 computed, 6 already recorded" -- \
     "$SL" run "$SWEEP" --out "$FULL" --resume
