@@ -55,12 +55,21 @@ $(B)/san/%.o: %.c $(DEPS)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -O1 $(SAN) -MMD -MP -c $< -o $@
 
-# The git commit goes into every record; rewritten only when it changes.
+# The git commit goes into every record; rewritten only when it changes. A
+# tree that differs from the commit in what is built or read at run time
+# (src, lua, tests, Makefile: modified or untracked files alike) is
+# COMMIT-dirty-HASH, HASH the first 8 hex digits of the SHA-1 of that
+# difference, and SHADOWLAB_DIRTY lists the paths that differ.
+STAMPED := src lua tests Makefile
 $(B)/gen/version.h: FORCE
 	@mkdir -p $(dir $@)
 	@c=$$(git rev-parse --short=12 HEAD 2>/dev/null || echo unknown); \
-	 git diff --quiet HEAD -- 2>/dev/null || c="$$c-dirty"; \
-	 printf '#define SHADOWLAB_COMMIT "%s"\n' "$$c" > $@.new; \
+	 files=$$(git status --porcelain --untracked-files=all -- $(STAMPED) 2>/dev/null | cut -c4- | tr -d '"\\' | \
+	          tr '\n' ' ' | sed 's/ $$//'); \
+	 if [ -n "$$files" ]; then \
+	   h=$$( { git diff HEAD -- $(STAMPED); git ls-files -o --exclude-standard -- $(STAMPED) | xargs -r cat; } \
+	         2>/dev/null | sha1sum | cut -c1-8); c="$$c-dirty-$$h"; fi; \
+	 printf '#define SHADOWLAB_COMMIT "%s"\n#define SHADOWLAB_DIRTY "%.480s"\n' "$$c" "$$files" > $@.new; \
 	 cmp -s $@.new $@ && rm -f $@.new || mv $@.new $@
 $(B)/obj/src/lab/record.o $(B)/san/src/lab/record.o: $(B)/gen/version.h
 $(B)/fuzz/src/lab/record.o $(B)/fuzz/src/lua/lshadowlab.o: $(B)/gen/version.h

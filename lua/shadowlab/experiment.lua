@@ -332,6 +332,7 @@ end
 
 function Experiment:run_one(config, o, header)
   local row = { index = config.index, key = config.key, label = config.label, experiment = header.fingerprint,
+                lua_helpers = records.helpers_hash(),
                 technique = config.entry.technique.name, params = config.entry.params,
                 variant = { scene = config.variant.info.name, file = config.variant.file,
                             overrides = config.variant.overrides, label = config.variant.label } }
@@ -378,7 +379,7 @@ local function refuse_mixed_builds(o, writer, mine)
   end
   if pending == 0 then return end
   local here = sl.machine()
-  here.host = nil
+  here.host, here.lua = nil, records.helpers_hash()
   local mine_text = records.build_text(here)
   for _, b in ipairs(records.builds(writer.rows)) do
     if b.text ~= mine_text then

@@ -109,6 +109,7 @@ records.standard_columns = {
   { "host", record_field("machine", "host") },
   { "cpu", record_field("machine", "cpu") },
   { "commit", record_field("machine", "commit") },
+  { "lua_helpers", function(r) return r.lua_helpers end },
   { "error", function(r) return r.error end },
 }
 
@@ -118,12 +119,34 @@ records.standard_columns = {
 function records.build_of(row)
   local m = row.record and row.record.machine
   if not m then return nil end
-  return { commit = m.commit, cpu = m.cpu, arch = m.arch, threads = m.threads }
+  return { commit = m.commit, lua = row.lua_helpers, cpu = m.cpu, arch = m.arch, threads = m.threads }
 end
 
 function records.build_text(b)
-  return string.format("commit %s, %s (%s), %s threads", tostring(b.commit), tostring(b.cpu), tostring(b.arch),
-                       tostring(b.threads))
+  return string.format("commit %s (Lua helpers %s), %s (%s), %s threads", tostring(b.commit), tostring(b.lua),
+                       tostring(b.cpu), tostring(b.arch), tostring(b.threads))
+end
+
+-- A hash of the lab's Lua helpers (lua/shadowlab/*.lua) as this process finds
+-- them: they are read at run time, so the binary's commit stamp cannot see
+-- them change after the build. Experiments record it in every row.
+local helpers_hash_memo
+function records.helpers_hash()
+  if helpers_hash_memo then return helpers_hash_memo end
+  local dir = sl.root .. "/lua/shadowlab"
+  local names, parts = sl.dir(dir) or {}, {}
+  table.sort(names)
+  for _, name in ipairs(names) do
+    if name:match("%.lua$") then
+      local f = io.open(dir .. "/" .. name, "rb")
+      if f then
+        parts[#parts + 1] = name .. "\0" .. f:read("a")
+        f:close()
+      end
+    end
+  end
+  helpers_hash_memo = sl.hash(table.concat(parts, "\0"))
+  return helpers_hash_memo
 end
 
 -- The distinct builds of rows, in first-seen order, each with its row count.

@@ -28,6 +28,7 @@ static void write_machine(JsonWriter *w, int threads)
     json_string(w, "cpu", cpu);
     json_int(w, "threads", threads);
     json_string(w, "commit", SHADOWLAB_COMMIT);
+    json_string(w, "dirty_files", SHADOWLAB_DIRTY); /* what differs from the commit at build time */
     json_object_end(w);
 }
 
