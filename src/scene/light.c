@@ -160,23 +160,39 @@ LightSample light_sample_center(const Light *l, vec3 p)
     return s;
 }
 
-/* Largest value of n . (q - p) over the light's points q: the light is
- * entirely below p's tangent plane when it is <= 0. */
-static float max_height_above_plane(const Light *l, vec3 p, vec3 n)
+/* Height of the light's centre above p's tangent plane, n . (c - p), and
+ * the half-extent of its points along n: every light point q has
+ * n . (q - p) within centre +- half_extent, both bounds reached. A sphere
+ * light's extent is its radius, which also bounds the cone of directions it
+ * subtends from p (|n . w| < sin(theta_max) = R / d iff |n . (c - p)| < R);
+ * a disk's is R sin(angle between n and its axis); a rectangle's the sum of
+ * its half sides' projections. Delta lights have none (a directional light's
+ * "centre" is its direction toward the light). */
+static void height_above_plane(const Light *l, vec3 p, vec3 n, float *centre, float *half_extent)
 {
-    float h_c = v3_dot(n, v3_sub(l->position, p));
+    *centre = v3_dot(n, v3_sub(l->position, p));
+    *half_extent = 0.0f;
     switch (l->kind) {
-    case LIGHT_SPHERE: return h_c + l->radius;
+    case LIGHT_SPHERE: *half_extent = l->radius; break;
     case LIGHT_DISK: {
         float c = v3_dot(n, l->direction);
-        return h_c + l->radius * sqrtf(fmaxf(0.0f, 1.0f - c * c));
+        *half_extent = l->radius * sqrtf(fmaxf(0.0f, 1.0f - c * c));
+        break;
     }
     case LIGHT_RECT:
     case LIGHT_TEXTURED_RECT:
-        return h_c + 0.5f * (l->width * fabsf(v3_dot(n, rect_right(l))) + l->height * fabsf(v3_dot(n, l->up)));
-    case LIGHT_DIRECTIONAL: return -v3_dot(n, l->direction);
-    default: return h_c;
+        *half_extent = 0.5f * (l->width * fabsf(v3_dot(n, rect_right(l))) + l->height * fabsf(v3_dot(n, l->up)));
+        break;
+    case LIGHT_DIRECTIONAL: *centre = -v3_dot(n, l->direction); break;
+    default: break;
     }
+}
+
+bool light_crosses_horizon(const Light *l, vec3 p, vec3 n)
+{
+    float centre, half_extent;
+    height_above_plane(l, p, n, &centre, &half_extent);
+    return centre - half_extent < 0.0f && centre + half_extent > 0.0f;
 }
 
 SampleClass light_classify(const Light *l, vec3 p, vec3 n)
@@ -188,5 +204,7 @@ SampleClass light_classify(const Light *l, vec3 p, vec3 n)
     bool one_sided = l->kind == LIGHT_RECT || l->kind == LIGHT_TEXTURED_RECT || l->kind == LIGHT_DISK;
     if (one_sided && v3_dot(v3_sub(p, l->position), l->direction) <= 0.0f) return SAMPLE_OUTSIDE_LIGHT;
     if (l->kind == LIGHT_SPHERE && v3_len(v3_sub(p, l->position)) <= l->radius) return SAMPLE_LIT_CANDIDATE;
-    return max_height_above_plane(l, p, n) > 0.0f ? SAMPLE_LIT_CANDIDATE : SAMPLE_BACKFACING;
+    float centre, half_extent;
+    height_above_plane(l, p, n, &centre, &half_extent);
+    return centre + half_extent > 0.0f ? SAMPLE_LIT_CANDIDATE : SAMPLE_BACKFACING;
 }
