@@ -63,6 +63,22 @@ static void empty_lane(Batch *b, int k)
     b->ray.tnear[k] = b->ray.tfar[k] = b->ray.time[k] = 0.0f;
 }
 
+/* Lane k traces the open segment from org toward the light sample s
+ * (course Eq. 1.1), stored in the batch for the accumulation. */
+static void aim_lane(Batch *b, int k, vec3 org, const LightSample *s)
+{
+    b->ls[k] = *s;
+    b->valid[k] = -1;
+    b->ray.org_x[k] = org.x; b->ray.org_y[k] = org.y; b->ray.org_z[k] = org.z;
+    b->ray.dir_x[k] = s->dir_world.x; b->ray.dir_y[k] = s->dir_world.y; b->ray.dir_z[k] = s->dir_world.z;
+    b->ray.tnear[k] = 0.0f;
+    b->ray.tfar[k] = isinf(s->dist) ? INFINITY : s->dist * (1.0f - 1e-5f);
+    b->ray.time[k] = 0.0f;
+    b->ray.mask[k] = 0xFFFFFFFFu;
+    b->ray.id[k] = (unsigned)k;
+    b->ray.flags[k] = 0;
+}
+
 /* The horizon is shading, not shadow (course §1: Eq. 1.1 integrates over
  * H+(p) only): a light sample on or below the geometric tangent plane of p
  * (n_geom) is neither traced nor counted in the visibility, which is thus the
@@ -83,23 +99,24 @@ static void fill_batch(Batch *b, const Light *l, vec3 org, vec3 p, vec3 n_geom, 
         if (i >= count) { empty_lane(b, k); continue; }
         float u, v;
         sample_2d(prm->pattern, stream, i, count, &u, &v);
-        LightSample *s = &b->ls[k];
-        *s = light_sample(l, p, u, v);
-        if (v3_dot(n_geom, s->dir_world) <= 0.0f) {
+        LightSample s = light_sample(l, p, u, v);
+        if (v3_dot(n_geom, s.dir_world) <= 0.0f) {
             empty_lane(b, k);
             b->below_horizon++;
-            continue;
-        }
-        b->valid[k] = -1;
-        b->ray.org_x[k] = org.x; b->ray.org_y[k] = org.y; b->ray.org_z[k] = org.z;
-        b->ray.dir_x[k] = s->dir_world.x; b->ray.dir_y[k] = s->dir_world.y; b->ray.dir_z[k] = s->dir_world.z;
-        b->ray.tnear[k] = 0.0f;
-        b->ray.tfar[k] = isinf(s->dist) ? INFINITY : s->dist * (1.0f - 1e-5f); /* open segment (course Eq. 1.1) */
-        b->ray.time[k] = 0.0f;
-        b->ray.mask[k] = 0xFFFFFFFFu;
-        b->ray.id[k] = (unsigned)k;
-        b->ray.flags[k] = 0;
+        } else aim_lane(b, k, org, &s);
     }
+}
+
+/* A part of the light above the horizon too thin for any of the pattern's
+ * samples (visibility's ratio would be 0/0): the visible fraction of a part
+ * shrinking to a point tends to that point's visibility, so one ray toward
+ * the light's highest point, reported with the error of one draw. */
+static void fill_highest(Batch *b, const Light *l, vec3 org, vec3 p, vec3 n_geom)
+{
+    LightSample s = light_sample_highest(l, p, n_geom);
+    b->below_horizon = 0;
+    aim_lane(b, 0, org, &s);
+    for (int k = 1; k < PACKET; k++) empty_lane(b, k);
 }
 
 /* Visibility sums of the `nc` channels the reference stores. */
@@ -191,6 +208,12 @@ static int trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx,
         if (j->p->measure == MEASURE_IRRADIANCE)
             accumulate_irradiance(&a, b, j->vs->n_shading_world[s], j->scene->objects[j->vs->object[s]].albedo);
         else accumulate_visibility(&a, b, nc);
+    }
+    if (rays == 0 && j->p->measure == MEASURE_VISIBILITY) {
+        fill_highest(b, j->light, org, p, ng);
+        rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
+        accumulate_visibility(&a, b, nc);
+        rays = 1;
     }
     float *v = j->out->value.data + (size_t)s * nc, *se = j->out->std_error.data + (size_t)s * nc;
     if (j->p->measure == MEASURE_IRRADIANCE) finish_irradiance(&a, v, se);

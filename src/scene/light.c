@@ -160,6 +160,35 @@ LightSample light_sample_center(const Light *l, vec3 p)
     return s;
 }
 
+/* The light's sample highest above the tangent plane of (p, n): the
+ * direction of a sphere light's cone nearest n (angle min(alpha, theta_max)
+ * from the axis, turned toward n), the rectangle's corner or the disk's rim
+ * point on n's side. */
+LightSample light_sample_highest(const Light *l, vec3 p, vec3 n)
+{
+    switch (l->kind) {
+    case LIGHT_SPHERE: {
+        vec3 w = v3_normalize_or(v3_sub(l->position, p), n), t, b;
+        float d = v3_len(v3_sub(l->position, p)), R = l->radius, one_minus_cos_max = 2.0f;
+        if (d > R) one_minus_cos_max = (R / d) * (R / d) / (1.0f + sqrtf(fmaxf(0.0f, 1.0f - (R / d) * (R / d))));
+        v3_basis(w, &t, &b);
+        float phi = atan2f(v3_dot(n, b), v3_dot(n, t)); /* sample_sphere's azimuth, in (-pi, pi] */
+        float u = fminf(1.0f - v3_dot(n, w), one_minus_cos_max) / one_minus_cos_max;
+        return sample_sphere(l, p, u, (phi < 0.0f ? phi + 2.0f * PI_F : phi) / (2.0f * PI_F));
+    }
+    case LIGHT_RECT:
+    case LIGHT_TEXTURED_RECT:
+        return sample_rect(l, p, v3_dot(n, rect_right(l)) > 0.0f ? 1.0f : 0.0f, v3_dot(n, l->up) > 0.0f ? 1.0f : 0.0f);
+    case LIGHT_DISK: {
+        vec3 t, b;
+        v3_basis(l->direction, &t, &b);
+        vec3 in_plane = v3_normalize_or(v3_sub(n, v3_scale(l->direction, v3_dot(n, l->direction))), t);
+        return area_sample(l, p, v3_madd(l->position, in_plane, l->radius), PI_F * l->radius * l->radius, radiance(l));
+    }
+    default: return light_sample(l, p, 0.5f, 0.5f);
+    }
+}
+
 /* Height of the light's centre above p's tangent plane, n . (c - p), and
  * the half-extent of its points along n: every light point q has
  * n . (q - p) within centre +- half_extent, both bounds reached. A sphere

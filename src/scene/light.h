@@ -43,5 +43,9 @@ SampleClass light_classify(const Light *light, vec3 p_world, vec3 n_world);
  * its points (a sphere light: of the cone of directions it subtends) lies
  * strictly above the plane and part strictly below. Never for delta lights. */
 bool light_crosses_horizon(const Light *light, vec3 p_world, vec3 n_world);
+/* The light's sample highest above that plane (the delta lights' only one):
+ * the reference's one ray toward a part of the light above the horizon too
+ * thin for any of its pattern's samples. */
+LightSample light_sample_highest(const Light *light, vec3 p_world, vec3 n_world);
 
 #endif
