@@ -7,8 +7,8 @@
  * plane cuts the light (its horizon crosses the light: a lit candidate whose
  * reference is the visibility of the light's part above the plane, see
  * scene/light.h) is scored in `terminator` instead, whatever its value; `all`
- * holds every lit candidate, terminator ones included. RGB images are scored per channel,
- * averaged (the max over channels for max_abs). */
+ * holds every lit candidate, terminator ones included. RGB images are scored
+ * per channel, averaged (the max over channels for max_abs). */
 #ifndef SL_METRICS_H
 #define SL_METRICS_H
 #include "rt/reference.h"
