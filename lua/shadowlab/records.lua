@@ -103,6 +103,7 @@ records.standard_columns = {
   { "penumbra_rmse", metric("penumbra", "rmse") },
   { "umbra_rmse", metric("umbra", "rmse") },
   { "lit_rmse", metric("lit", "rmse") },
+  { "terminator_rmse", metric("terminator", "rmse") },
   { "false_shadow", record_field("metrics", "false_shadow") },
   { "false_lit", record_field("metrics", "false_lit") },
   { "threads", record_field("machine", "threads") },

@@ -9,9 +9,10 @@ static bool compute_metrics(Lab *lab, CompareResult *out, Error *err)
 {
     double t0 = timer_now_s();
     const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), out->light_index, err);
+    const uint8_t *term = cls ? res_terminator(lab_resources(lab), lab_scene(lab), out->light_index, err) : NULL;
     const Image *v = &out->render.visibility;
-    if (!cls || !image_init(&out->signed_error, v->width, v->height, v->channels, err) ||
-        !metrics_compute(v, out->ref, cls, &out->metrics, &out->signed_error, err))
+    if (!term || !image_init(&out->signed_error, v->width, v->height, v->channels, err) ||
+        !metrics_compute(v, out->ref, cls, term, &out->metrics, &out->signed_error, err))
         return false;
     out->metrics_s = timer_now_s() - t0;
     out->error_scale = report_error_scale(out->metrics.region[REGION_ALL].max_abs);

@@ -187,7 +187,18 @@ static bool limit_no_ground_candidates(const Metrics *m, char *why, size_t n)
     return false;
 }
 
-/* Light inside the closed box: every lit candidate (the ground, the ball)
+/* Light cut by the ground's plane: the ground sees part of it, so its
+ * samples are scored as terminator (light.h's convention), never as
+ * penumbra of the light's part below the plane. */
+static bool limit_terminator_present(const Metrics *m, char *why, size_t n)
+{
+    if (m->region[REGION_TERMINATOR].count > 0) return true;
+    snprintf(why, n, "no terminator samples: the ground before a light its plane cuts was not flagged");
+    return false;
+}
+
+/* Light inside the closed box: every lit candidate (the ground, the ball;
+ * the ball's band whose plane cuts the light is scored as terminator)
  * is in the reference's umbra, and the technique must say so: mean light
  * leaked over them at most UMBRA_LEAK_MAX, at most UMBRA_LIT_MAX of them
  * estimated lit (> 0.5). */
@@ -197,9 +208,10 @@ static bool limit_no_ground_candidates(const Metrics *m, char *why, size_t n)
 static bool limit_all_umbra(const Metrics *m, char *why, size_t n)
 {
     const ErrorStats *all = &m->region[REGION_ALL], *umbra = &m->region[REGION_UMBRA];
-    if (all->count == 0 || umbra->count != all->count) {
-        snprintf(why, n, "the reference has %ld of %ld lit candidates in umbra: the light is not enclosed",
-                 umbra->count, all->count);
+    long terminator = m->region[REGION_TERMINATOR].count; /* the ball's band whose plane cuts the light */
+    if (all->count == 0 || umbra->count + terminator != all->count) {
+        snprintf(why, n, "the reference has %ld of %ld lit candidates in umbra (%ld terminator): the light is not enclosed",
+                 umbra->count, all->count, terminator);
         return false;
     }
     double lit = all->misclassified; /* the reference is 0 throughout: |e| > 0.5 is an estimate > 0.5 */
@@ -287,6 +299,15 @@ static void light_below(SceneSpec *s, LightKind k, const StabSettings *st)
     (void)k; (void)st;
     set3(s->light_pos, 0.6, -2, 0.4);
     set3(s->light_aim, 0, 0, 0);
+}
+
+/* Centre 0.1 below the ground, a third of the light's size: the plane
+ * y = 0 cuts it; an area light tilted up toward the box and the ball. */
+static void light_straddling(SceneSpec *s, LightKind k, const StabSettings *st)
+{
+    (void)k; (void)st;
+    set3(s->light_pos, -1.6, -0.1, -0.6);
+    set3(s->light_aim, 0, 0.4, 0);
 }
 
 /* 89.9 degrees from the ground's normal, 20 units from the centre. */
@@ -657,6 +678,9 @@ static const StabCase cases[] = {
      POSITIONED, PLAN_EACH, false, true, false, light_inside_bounds, NULL, {0}, NULL},
     {"light_below_receiver", GROUP_LIGHT, "light under the ground plane: the ground is back-facing, not shadowed",
      LIGHTS_ALL, PLAN_EACH, false, false, false, light_below, limit_no_ground_candidates, {0}, NULL},
+    {"light_straddling_receiver", GROUP_LIGHT,
+     "area light cut by the ground's plane (centre 0.1 below it): the ground is scored as terminator",
+     AREA, PLAN_EACH, false, false, false, light_straddling, limit_terminator_present, {0}, NULL},
     {"light_grazing_89.9deg", GROUP_LIGHT, "light at 89.9 degrees from the ground's normal",
      LIGHTS_ALL, PLAN_EACH, false, false, false, light_grazing, NULL, {0}, NULL},
     {"light_straight_down", GROUP_LIGHT, "light aimed exactly along -Y (a light 'look at' with up = +Y degenerates)",

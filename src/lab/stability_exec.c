@@ -233,8 +233,10 @@ static bool measure(const StabJob *j, Lab *lab, const Image *v, const uint8_t *c
     Error e;
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &e);
     if (!ref) return fail(r, "reference failed: %s", e.msg);
+    const uint8_t *term = res_terminator(lab_resources(lab), lab_scene(lab), 0, &e);
+    if (!term) return fail(r, "sample classes failed: %s", e.msg);
     Metrics m;
-    if (!metrics_compute(v, ref, cls, &m, NULL, &e)) return fail(r, "metrics failed: %s", e.msg);
+    if (!metrics_compute(v, ref, cls, term, &m, NULL, &e)) return fail(r, "metrics failed: %s", e.msg);
     r->ref_samples = light_is_delta(&lab_scene(lab)->lights[0]) ? 1 : rq.params.samples;
     r->noise_rms = m.noise_rms;
     if (m.region[REGION_ALL].count > 0) {

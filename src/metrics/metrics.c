@@ -6,7 +6,7 @@
 
 const char *region_name(Region r)
 {
-    static const char *const names[] = {"all", "penumbra", "umbra", "lit"};
+    static const char *const names[] = {"all", "penumbra", "umbra", "lit", "terminator"};
     return names[r];
 }
 
@@ -41,8 +41,11 @@ static ErrorStats finish(const Sums *s, int channels)
     return st;
 }
 
-static Region region_of(const float *ref, int nc)
+/* The region of a lit candidate: terminator where the horizon crosses the
+ * light (flag set), else by the reference's value. */
+static Region region_of(const float *ref, int nc, bool terminator)
 {
+    if (terminator) return REGION_TERMINATOR;
     double v = 0;
     for (int c = 0; c < nc; c++) v += ref[c];
     v /= nc;
@@ -60,8 +63,8 @@ static double sample_error(float est, float ref, Metrics *m)
     return (double)est - (double)ref;
 }
 
-bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls, Metrics *m, Image *signed_error,
-                     Error *err)
+bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls, const uint8_t *terminator,
+                     Metrics *m, Image *signed_error, Error *err)
 {
     const Image *rv = &ref->value;
     if (est->width != rv->width || est->height != rv->height || est->channels != rv->channels)
@@ -80,7 +83,7 @@ bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls,
             continue;
         }
         const float *r = rv->data + s * nc, *e = est->data + s * nc, *sd = ref->std_error.data + s * nc;
-        Region reg = region_of(r, nc);
+        Region reg = region_of(r, nc, terminator && terminator[s]);
         for (int c = 0; c < nc; c++) {
             double err_c = sample_error(e[c], r[c], m);
             add(&sums[REGION_ALL], err_c);

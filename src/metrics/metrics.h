@@ -3,13 +3,17 @@
  * back-facing, outside-the-light and non-receiver samples are counted apart,
  * never as shadow errors). Error e = estimate - reference: e > 0 is light
  * leaking, e < 0 over-darkening. Regions follow the reference: umbra V <= 0.01,
- * penumbra 0.01 < V < 0.99, lit V >= 0.99. RGB images are scored per channel,
- * averaged (the max over channels for max_abs). */
+ * penumbra 0.01 < V < 0.99, lit V >= 0.99, except that a sample whose tangent
+ * plane cuts the light (its horizon crosses the light: a lit candidate whose
+ * reference is the visibility of the light's part above the plane, see
+ * scene/light.h) is scored in `terminator` instead, whatever its value; `all`
+ * holds every lit candidate, terminator ones included. RGB images are scored
+ * per channel, averaged (the max over channels for max_abs). */
 #ifndef SL_METRICS_H
 #define SL_METRICS_H
 #include "rt/reference.h"
 
-typedef enum Region { REGION_ALL, REGION_PENUMBRA, REGION_UMBRA, REGION_LIT, REGION_COUNT } Region;
+typedef enum Region { REGION_ALL, REGION_PENUMBRA, REGION_UMBRA, REGION_LIT, REGION_TERMINATOR, REGION_COUNT } Region;
 const char *region_name(Region r);
 
 typedef struct ErrorStats {
@@ -32,9 +36,11 @@ typedef struct Metrics {
     long out_of_range;     /* estimates outside [0, 1] */
 } Metrics;
 
-/* `signed_error` (optional) receives e per sample and channel; 0 outside the
- * evaluated class. est and ref->value must have the same shape. */
-bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls, Metrics *m, Image *signed_error,
-                     Error *err);
+/* `terminator` (standard.h's res_terminator; NULL: no terminator region)
+ * flags the samples scored in REGION_TERMINATOR. `signed_error` (optional)
+ * receives e per sample and channel; 0 outside the evaluated class. est and
+ * ref->value must have the same shape. */
+bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls, const uint8_t *terminator,
+                     Metrics *m, Image *signed_error, Error *err);
 
 #endif

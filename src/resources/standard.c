@@ -76,31 +76,47 @@ const ViewSamples *res_view_samples(ResourceManager *rm, const Scene *scene, Err
 /* ---- sample classes per light ----------------------------------------- */
 
 typedef struct ClassArgs { const ViewSamples *vs; const Scene *scene; int light; } ClassArgs;
-typedef struct Classes { uint8_t *cls; size_t n; } Classes;
+/* cls: SampleClass per sample; terminator: 1 where the sample is a lit
+ * candidate whose tangent plane cuts the light (light_crosses_horizon). */
+typedef struct Classes { uint8_t *cls, *terminator; size_t n; } Classes;
+
+static void classes_destroy(void *r)
+{
+    free(((Classes *)r)->cls);
+    free(((Classes *)r)->terminator);
+    free(r);
+}
+
+static void mark_terminator(const ViewSamples *vs, const Light *l, const uint8_t *cls, uint8_t *terminator)
+{
+#pragma omp parallel for schedule(static)
+    for (int s = 0; s < vs->count; s++)
+        terminator[s] = cls[s] == SAMPLE_LIT_CANDIDATE &&
+                        light_crosses_horizon(l, vs->p_world[s], vs->n_geom_world[s]);
+}
 
 static void *build_classes(const void *args, Error *err)
 {
     const ClassArgs *a = args;
-    Classes *c = malloc(sizeof *c);
-    if (c) c->cls = malloc((size_t)a->vs->count);
-    if (!c || !c->cls) {
-        free(c);
+    Classes *c = calloc(1, sizeof *c);
+    if (c) {
+        c->cls = malloc((size_t)a->vs->count);
+        c->terminator = malloc((size_t)a->vs->count);
+    }
+    if (!c || !c->cls || !c->terminator) {
+        if (c) classes_destroy(c);
         error_set(err, "out of memory");
         return NULL;
     }
     c->n = (size_t)a->vs->count;
     view_samples_classify(a->vs, a->scene, a->light, c->cls);
+    mark_terminator(a->vs, &a->scene->lights[a->light], c->cls, c->terminator);
     return c;
 }
-static size_t classes_bytes(const void *r) { return ((const Classes *)r)->n; }
-static void classes_destroy(void *r)
-{
-    free(((Classes *)r)->cls);
-    free(r);
-}
+static size_t classes_bytes(const void *r) { return 2 * ((const Classes *)r)->n; }
 static const ResourceKind kind_classes = {"sample_classes", classes_bytes, classes_destroy, RES_GBUFFER};
 
-const uint8_t *res_classes(ResourceManager *rm, const Scene *scene, int light_index, Error *err)
+static const Classes *acquire_classes(ResourceManager *rm, const Scene *scene, int light_index, Error *err)
 {
     const ViewSamples *vs = res_view_samples(rm, scene, err);
     if (!vs) return NULL;
@@ -111,8 +127,19 @@ const uint8_t *res_classes(ResourceManager *rm, const Scene *scene, int light_in
     ClassArgs a = {vs, scene, light_index};
     char desc[160];
     snprintf(desc, sizeof desc, "light %d (%s)", light_index + 1, light_kind_name(scene->lights[light_index].kind));
-    const Classes *c = rm_acquire(rm, &kind_classes, hash_final(&h), desc, build_classes, &a, err);
+    return rm_acquire(rm, &kind_classes, hash_final(&h), desc, build_classes, &a, err);
+}
+
+const uint8_t *res_classes(ResourceManager *rm, const Scene *scene, int light_index, Error *err)
+{
+    const Classes *c = acquire_classes(rm, scene, light_index, err);
     return c ? c->cls : NULL;
+}
+
+const uint8_t *res_terminator(ResourceManager *rm, const Scene *scene, int light_index, Error *err)
+{
+    const Classes *c = acquire_classes(rm, scene, light_index, err);
+    return c ? c->terminator : NULL;
 }
 
 /* ---- constant point tables ---------------------------------------------- */
@@ -160,7 +187,7 @@ const PointTable *res_point_table(ResourceManager *rm, const char *generator, Po
 /* ---- references --------------------------------------------------------- */
 
 /* Bump when the reference's algorithm changes, so old cache entries miss. */
-#define REFERENCE_VERSION 1
+#define REFERENCE_VERSION 2 /* 2: visibility over the part of the light above the horizon */
 
 const char *ref_origin_name(RefOrigin o)
 {

@@ -10,6 +10,10 @@
 const RtScene *res_bvh(ResourceManager *rm, const Scene *scene, RtGeometrySet set, Error *err);
 const ViewSamples *res_view_samples(ResourceManager *rm, const Scene *scene, Error *err);
 const uint8_t *res_classes(ResourceManager *rm, const Scene *scene, int light_index, Error *err);
+/* Per view sample, 1 where it is a lit candidate whose tangent plane cuts
+ * the light (scene/light.h's light_crosses_horizon): the metrics' terminator
+ * region. Built with the classes, in the same resource. */
+const uint8_t *res_terminator(ResourceManager *rm, const Scene *scene, int light_index, Error *err);
 
 /* A scene-independent table of n points (a tap pattern, a Poisson disk),
  * made by fill(pts, n) with the generator's own fixed seed and keyed by the

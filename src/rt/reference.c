@@ -45,37 +45,78 @@ typedef struct Accum {
     int n;
 } Accum;
 
+/* valid: the lanes traced. below_horizon: light samples drawn but not
+ * traced, on or below the receiver's geometric tangent plane. */
 typedef struct Batch {
     LightSample ls[PACKET];
     _Alignas(64) struct RTCRay16 ray;
     _Alignas(64) int valid[PACKET];
+    int below_horizon;
 } Batch;
 
-static void fill_batch(Batch *b, const Light *l, vec3 org, vec3 p, uint32_t stream, int first, int count,
-                       const ReferenceParams *prm)
+/* Embree reads every lane: keep untraced ones finite and empty. */
+static void empty_lane(Batch *b, int k)
 {
+    b->valid[k] = 0;
+    b->ray.org_x[k] = b->ray.org_y[k] = b->ray.org_z[k] = 0.0f;
+    b->ray.dir_x[k] = b->ray.dir_y[k] = 0.0f; b->ray.dir_z[k] = 1.0f;
+    b->ray.tnear[k] = b->ray.tfar[k] = b->ray.time[k] = 0.0f;
+}
+
+/* Lane k traces the open segment from org toward the light sample s
+ * (course Eq. 1.1), stored in the batch for the accumulation. */
+static void aim_lane(Batch *b, int k, vec3 org, const LightSample *s)
+{
+    b->ls[k] = *s;
+    b->valid[k] = -1;
+    b->ray.org_x[k] = org.x; b->ray.org_y[k] = org.y; b->ray.org_z[k] = org.z;
+    b->ray.dir_x[k] = s->dir_world.x; b->ray.dir_y[k] = s->dir_world.y; b->ray.dir_z[k] = s->dir_world.z;
+    b->ray.tnear[k] = 0.0f;
+    b->ray.tfar[k] = isinf(s->dist) ? INFINITY : s->dist * (1.0f - 1e-5f);
+    b->ray.time[k] = 0.0f;
+    b->ray.mask[k] = 0xFFFFFFFFu;
+    b->ray.id[k] = (unsigned)k;
+    b->ray.flags[k] = 0;
+}
+
+/* The horizon is shading, not shadow (course §1: Eq. 1.1 integrates over
+ * H+(p) only): a light sample on or below the geometric tangent plane of p
+ * (n_geom) is neither traced nor counted in the visibility, which is thus the
+ * ratio over the samples above the plane, the visible fraction of the part
+ * of the light above it. Light samples are equally weighted points of an R2,
+ * stratified or independent pattern over the light, so dropping some keeps
+ * that ratio consistent (unbiased given the count kept); irradiance counts
+ * them as zero terms of its mean (accumulate_irradiance). So the receiver's
+ * caster flag no longer decides its own horizon: the rays traced leave
+ * above the plane, where a convex mesh cannot block them, and a receiver
+ * that casts still shadows itself elsewhere (a bunny's ear on its back). */
+static void fill_batch(Batch *b, const Light *l, vec3 org, vec3 p, vec3 n_geom, uint32_t stream, int first,
+                       int count, const ReferenceParams *prm)
+{
+    b->below_horizon = 0;
     for (int k = 0; k < PACKET; k++) {
         int i = first + k;
-        b->valid[k] = i < count ? -1 : 0;
-        if (i >= count) { /* Embree reads every lane: keep unused ones finite and empty */
-            b->ray.org_x[k] = b->ray.org_y[k] = b->ray.org_z[k] = 0.0f;
-            b->ray.dir_x[k] = b->ray.dir_y[k] = 0.0f; b->ray.dir_z[k] = 1.0f;
-            b->ray.tnear[k] = b->ray.tfar[k] = b->ray.time[k] = 0.0f;
-            continue;
-        }
+        if (i >= count) { empty_lane(b, k); continue; }
         float u, v;
         sample_2d(prm->pattern, stream, i, count, &u, &v);
-        LightSample *s = &b->ls[k];
-        *s = light_sample(l, p, u, v);
-        b->ray.org_x[k] = org.x; b->ray.org_y[k] = org.y; b->ray.org_z[k] = org.z;
-        b->ray.dir_x[k] = s->dir_world.x; b->ray.dir_y[k] = s->dir_world.y; b->ray.dir_z[k] = s->dir_world.z;
-        b->ray.tnear[k] = 0.0f;
-        b->ray.tfar[k] = isinf(s->dist) ? INFINITY : s->dist * (1.0f - 1e-5f); /* open segment (course Eq. 1.1) */
-        b->ray.time[k] = 0.0f;
-        b->ray.mask[k] = 0xFFFFFFFFu;
-        b->ray.id[k] = (unsigned)k;
-        b->ray.flags[k] = 0;
+        LightSample s = light_sample(l, p, u, v);
+        if (v3_dot(n_geom, s.dir_world) <= 0.0f) {
+            empty_lane(b, k);
+            b->below_horizon++;
+        } else aim_lane(b, k, org, &s);
     }
+}
+
+/* A part of the light above the horizon too thin for any of the pattern's
+ * samples (visibility's ratio would be 0/0): the visible fraction of a part
+ * shrinking to a point tends to that point's visibility, so one ray toward
+ * the light's highest point, reported with the error of one draw. */
+static void fill_highest(Batch *b, const Light *l, vec3 org, vec3 p, vec3 n_geom)
+{
+    LightSample s = light_sample_highest(l, p, n_geom);
+    b->below_horizon = 0;
+    aim_lane(b, 0, org, &s);
+    for (int k = 1; k < PACKET; k++) empty_lane(b, k);
 }
 
 /* Visibility sums of the `nc` channels the reference stores. */
@@ -111,6 +152,7 @@ static void accumulate_irradiance(Accum *a, const Batch *b, vec3 n_shading, vec3
         }
         a->n++;
     }
+    a->n += b->below_horizon; /* light below the horizon: zero terms (fill_batch) */
 }
 
 /* Visibility with a Laplace-smoothed binomial standard error, p~ = (k+1)/(n+2)
@@ -150,23 +192,33 @@ typedef struct RefJob {
     Reference *out;
 } RefJob;
 
-static void trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx, Batch *b)
+/* Estimates sample s; returns the rays traced (fill_batch drops some). */
+static int trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx, Batch *b)
 {
     vec3 p = j->vs->p_world[s], ng = j->vs->n_geom_world[s];
     vec3 org = v3_madd(p, ng, rt_ray_offset(j->extent, p));
     uint32_t stream = sampling_stream(j->p->seed, (uint32_t)s);
     int nc = j->out->value.channels;
     Accum a = {0};
+    int rays = 0;
     for (int first = 0; first < j->count; first += PACKET) {
-        fill_batch(b, j->light, org, p, stream, first, j->count, j->p);
+        fill_batch(b, j->light, org, p, ng, stream, first, j->count, j->p);
+        rays += (j->count - first < PACKET ? j->count - first : PACKET) - b->below_horizon;
         rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
         if (j->p->measure == MEASURE_IRRADIANCE)
             accumulate_irradiance(&a, b, j->vs->n_shading_world[s], j->scene->objects[j->vs->object[s]].albedo);
         else accumulate_visibility(&a, b, nc);
     }
+    if (rays == 0 && j->p->measure == MEASURE_VISIBILITY) {
+        fill_highest(b, j->light, org, p, ng);
+        rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
+        accumulate_visibility(&a, b, nc);
+        rays = 1;
+    }
     float *v = j->out->value.data + (size_t)s * nc, *se = j->out->std_error.data + (size_t)s * nc;
     if (j->p->measure == MEASURE_IRRADIANCE) finish_irradiance(&a, v, se);
     else finish_visibility(&a, v, se, nc);
+    return rays;
 }
 
 /* Value of samples that are not traced: unlit (0) unless on a non-receiver,
@@ -214,8 +266,7 @@ bool reference_compute(const RtScene *casters, const Scene *scene, int light_ind
         for (int y = 0; y < vs->height; y++) {
             for (int s = y * vs->width; s < (y + 1) * vs->width; s++) {
                 if (!traced(&j, cls[s])) { fill_untraced(&j, s, cls[s]); continue; }
-                trace_sample(&j, s, &ctx, &b);
-                rays += j.count;
+                rays += trace_sample(&j, s, &ctx, &b);
             }
             progress_add(&prog, 1);
         }

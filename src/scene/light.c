@@ -160,23 +160,68 @@ LightSample light_sample_center(const Light *l, vec3 p)
     return s;
 }
 
-/* Largest value of n . (q - p) over the light's points q: the light is
- * entirely below p's tangent plane when it is <= 0. */
-static float max_height_above_plane(const Light *l, vec3 p, vec3 n)
+/* The light's sample highest above the tangent plane of (p, n): the
+ * direction of a sphere light's cone nearest n (angle min(alpha, theta_max)
+ * from the axis, turned toward n), the rectangle's corner or the disk's rim
+ * point on n's side. */
+LightSample light_sample_highest(const Light *l, vec3 p, vec3 n)
 {
-    float h_c = v3_dot(n, v3_sub(l->position, p));
     switch (l->kind) {
-    case LIGHT_SPHERE: return h_c + l->radius;
-    case LIGHT_DISK: {
-        float c = v3_dot(n, l->direction);
-        return h_c + l->radius * sqrtf(fmaxf(0.0f, 1.0f - c * c));
+    case LIGHT_SPHERE: {
+        vec3 w = v3_normalize_or(v3_sub(l->position, p), n), t, b;
+        float d = v3_len(v3_sub(l->position, p)), R = l->radius, one_minus_cos_max = 2.0f;
+        if (d > R) one_minus_cos_max = (R / d) * (R / d) / (1.0f + sqrtf(fmaxf(0.0f, 1.0f - (R / d) * (R / d))));
+        v3_basis(w, &t, &b);
+        float phi = atan2f(v3_dot(n, b), v3_dot(n, t)); /* sample_sphere's azimuth, in (-pi, pi] */
+        float u = fminf(1.0f - v3_dot(n, w), one_minus_cos_max) / one_minus_cos_max;
+        return sample_sphere(l, p, u, (phi < 0.0f ? phi + 2.0f * PI_F : phi) / (2.0f * PI_F));
     }
     case LIGHT_RECT:
     case LIGHT_TEXTURED_RECT:
-        return h_c + 0.5f * (l->width * fabsf(v3_dot(n, rect_right(l))) + l->height * fabsf(v3_dot(n, l->up)));
-    case LIGHT_DIRECTIONAL: return -v3_dot(n, l->direction);
-    default: return h_c;
+        return sample_rect(l, p, v3_dot(n, rect_right(l)) > 0.0f ? 1.0f : 0.0f, v3_dot(n, l->up) > 0.0f ? 1.0f : 0.0f);
+    case LIGHT_DISK: {
+        vec3 t, b;
+        v3_basis(l->direction, &t, &b);
+        vec3 in_plane = v3_normalize_or(v3_sub(n, v3_scale(l->direction, v3_dot(n, l->direction))), t);
+        return area_sample(l, p, v3_madd(l->position, in_plane, l->radius), PI_F * l->radius * l->radius, radiance(l));
     }
+    default: return light_sample(l, p, 0.5f, 0.5f);
+    }
+}
+
+/* Height of the light's centre above p's tangent plane, n . (c - p), and
+ * the half-extent of its points along n: every light point q has
+ * n . (q - p) within centre +- half_extent, both bounds reached. A sphere
+ * light's extent is its radius, which also bounds the cone of directions it
+ * subtends from p (|n . w| < sin(theta_max) = R / d iff |n . (c - p)| < R);
+ * a disk's is R sin(angle between n and its axis); a rectangle's the sum of
+ * its half sides' projections. Delta lights have none (a directional light's
+ * "centre" is its direction toward the light). */
+static void height_above_plane(const Light *l, vec3 p, vec3 n, float *centre, float *half_extent)
+{
+    *centre = v3_dot(n, v3_sub(l->position, p));
+    *half_extent = 0.0f;
+    switch (l->kind) {
+    case LIGHT_SPHERE: *half_extent = l->radius; break;
+    case LIGHT_DISK: {
+        float c = v3_dot(n, l->direction);
+        *half_extent = l->radius * sqrtf(fmaxf(0.0f, 1.0f - c * c));
+        break;
+    }
+    case LIGHT_RECT:
+    case LIGHT_TEXTURED_RECT:
+        *half_extent = 0.5f * (l->width * fabsf(v3_dot(n, rect_right(l))) + l->height * fabsf(v3_dot(n, l->up)));
+        break;
+    case LIGHT_DIRECTIONAL: *centre = -v3_dot(n, l->direction); break;
+    default: break;
+    }
+}
+
+bool light_crosses_horizon(const Light *l, vec3 p, vec3 n)
+{
+    float centre, half_extent;
+    height_above_plane(l, p, n, &centre, &half_extent);
+    return centre - half_extent < 0.0f && centre + half_extent > 0.0f;
 }
 
 SampleClass light_classify(const Light *l, vec3 p, vec3 n)
@@ -188,5 +233,7 @@ SampleClass light_classify(const Light *l, vec3 p, vec3 n)
     bool one_sided = l->kind == LIGHT_RECT || l->kind == LIGHT_TEXTURED_RECT || l->kind == LIGHT_DISK;
     if (one_sided && v3_dot(v3_sub(p, l->position), l->direction) <= 0.0f) return SAMPLE_OUTSIDE_LIGHT;
     if (l->kind == LIGHT_SPHERE && v3_len(v3_sub(p, l->position)) <= l->radius) return SAMPLE_LIT_CANDIDATE;
-    return max_height_above_plane(l, p, n) > 0.0f ? SAMPLE_LIT_CANDIDATE : SAMPLE_BACKFACING;
+    float centre, half_extent;
+    height_above_plane(l, p, n, &centre, &half_extent);
+    return centre + half_extent > 0.0f ? SAMPLE_LIT_CANDIDATE : SAMPLE_BACKFACING;
 }

@@ -2,7 +2,11 @@
  * and by stochastic techniques (pbrt's split: sampling here, integration in
  * the caller). Also the classification of a surface point against a light:
  * back-facing points are "unlit by shading", not "in shadow" (course §1, Eq. 1.1
- * restricts occluders to the positive half-space H+(p)). */
+ * restricts occluders to the positive half-space H+(p)). The same convention
+ * holds for a light the tangent plane cuts: the part below the plane is
+ * shading (the horizon), not shadow, so the reference measures visibility
+ * over the part above it and such a sample is scored in its own metrics
+ * region, `terminator` (light_crosses_horizon). */
 #ifndef SL_LIGHT_H
 #define SL_LIGHT_H
 #include "scene/scene.h"
@@ -11,7 +15,7 @@
  * samples enter shadow metrics. */
 typedef enum SampleClass {
     SAMPLE_BACKGROUND = 0,    /* the primary ray hit nothing */
-    SAMPLE_LIT_CANDIDATE = 1, /* faces (part of) the light: visibility is measured */
+    SAMPLE_LIT_CANDIDATE = 1, /* faces (part of) the light: visibility is measured over that part */
     SAMPLE_BACKFACING = 2,    /* normal faces away from the whole light */
     SAMPLE_OUTSIDE_LIGHT = 3, /* outside a spot cone or behind a one-sided area light */
     SAMPLE_NOT_RECEIVER = 4,  /* on an object flagged receiver = false */
@@ -35,5 +39,13 @@ LightSample light_sample(const Light *light, vec3 p_world, float u, float v);
 LightSample light_sample_center(const Light *light, vec3 p_world);
 bool light_is_delta(const Light *light);
 SampleClass light_classify(const Light *light, vec3 p_world, vec3 n_world);
+/* True when the tangent plane of (p_world, n_world) cuts the light: part of
+ * its points (a sphere light: of the cone of directions it subtends) lies
+ * strictly above the plane and part strictly below. Never for delta lights. */
+bool light_crosses_horizon(const Light *light, vec3 p_world, vec3 n_world);
+/* The light's sample highest above that plane (the delta lights' only one):
+ * the reference's one ray toward a part of the light above the horizon too
+ * thin for any of its pattern's samples. */
+LightSample light_sample_highest(const Light *light, vec3 p_world, vec3 n_world);
 
 #endif

@@ -11,7 +11,8 @@ bool signed_error(Lab *lab, const Image *v, int samples, Metrics *m, Image *e)
     RefRequest rq = {0, {MEASURE_VISIBILITY, samples, SAMPLING_STRATIFIED, 1}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     const uint8_t *cls = ref ? res_classes(lab_resources(lab), lab_scene(lab), 0, &err) : NULL;
-    if (cls && image_init(e, v->width, v->height, v->channels, &err) && metrics_compute(v, ref, cls, m, e, &err))
+    const uint8_t *term = cls ? res_terminator(lab_resources(lab), lab_scene(lab), 0, &err) : NULL;
+    if (term && image_init(e, v->width, v->height, v->channels, &err) && metrics_compute(v, ref, cls, term, m, e, &err))
         return true;
     image_free(e);
     printf("    signed error: %s\n", err.msg);

@@ -69,7 +69,8 @@ bool soft_metrics(Lab *lab, const Image *v, int samples, Metrics *m)
     RefRequest rq = {0, {MEASURE_VISIBILITY, samples, SAMPLING_STRATIFIED, 1}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     const uint8_t *cls = ref ? res_classes(lab_resources(lab), lab_scene(lab), 0, &err) : NULL;
-    if (cls && metrics_compute(v, ref, cls, m, NULL, &err)) return true;
+    const uint8_t *term = cls ? res_terminator(lab_resources(lab), lab_scene(lab), 0, &err) : NULL;
+    if (term && metrics_compute(v, ref, cls, term, m, NULL, &err)) return true;
     printf("    metrics: %s\n", err.msg);
     return false;
 }

@@ -27,9 +27,10 @@ static Scored score(Lab *lab, const char *tech, const char *list)
     RefRequest ref_rq = {0, {MEASURE_VISIBILITY, REF_SAMPLES, SAMPLING_R2, 1}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &ref_rq, &info, &err);
     const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
-    if (!ref || !cls) { printf("    %s\n", err.msg); return out; }
+    const uint8_t *term = res_terminator(lab_resources(lab), lab_scene(lab), 0, &err);
+    if (!ref || !cls || !term) { printf("    %s\n", err.msg); return out; }
     if (!filtered_render(lab, tech, list, &rr)) return out;
-    out.ok = metrics_compute(&rr.visibility, ref, cls, &out.m, NULL, &err);
+    out.ok = metrics_compute(&rr.visibility, ref, cls, term, &out.m, NULL, &err);
     render_result_free(&rr);
     printf("    %-5s %-36s rmse %.4f | umbra leak %.4f | penumbra over-dark %.4f\n", tech, list, out.m.region[REGION_ALL].rmse,
            out.m.region[REGION_UMBRA].leak_mean, out.m.region[REGION_PENUMBRA].dark_mean);

@@ -261,9 +261,10 @@ static double pcf_penumbra_rmse(Lab *lab, const char *K, double *all_rmse)
     RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    const uint8_t *term = res_terminator(lab_resources(lab), lab_scene(lab), 0, &err);
     Metrics m;
-    if (!ref || !cls || !render(lab, "pcf", p, 2, &r)) return NAN;
-    bool ok = metrics_compute(&r.visibility, ref, cls, &m, NULL, &err);
+    if (!ref || !cls || !term || !render(lab, "pcf", p, 2, &r)) return NAN;
+    bool ok = metrics_compute(&r.visibility, ref, cls, term, &m, NULL, &err);
     render_result_free(&r);
     *all_rmse = ok ? m.region[REGION_ALL].rmse : NAN;
     return ok ? m.region[REGION_PENUMBRA].rmse : NAN;
