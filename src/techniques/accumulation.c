@@ -239,10 +239,12 @@ static bool cover(double lo, double hi, double base, int K, int *k0, int *k1)
 /* One axis of a caster's footprint on the plane (lexels from q): its lexel's
  * edges e_lo = d - 1/2 and e_hi = d + 1/2 scaled by its size (l_r - q =
  * size (l - q), backproject.h), each edge reaching the farther of its own
- * and its neighbour's projection of it (0: no caster there) [OWN: gap
- * filling]. Neighbouring lexels of one surface at different depths project
- * with different sizes, so elementary casters alone leave unmarked slits of
- * D between them, lit through a closed surface; the surface joins them. */
+ * and its neighbour's projection of it (0: no caster there): gap filling,
+ * course §5.2.3.3 ("gaps leak light. Fix by extending patches to the ...
+ * neighbours", Guennebaud 2006; here all four, which "knowingly accepts
+ * overocclusion"). Neighbouring lexels of one surface at different depths
+ * project with different sizes, so elementary casters alone leave unmarked
+ * slits of D between them, lit through a closed surface. */
 static void footprint_axis(double d, double size, double size_lo, double size_hi, double *lo, double *hi)
 {
     double e_lo = d - 0.5, e_hi = d + 0.5;
