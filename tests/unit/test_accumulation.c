@@ -3,7 +3,8 @@
  * case (a caster at the receiver's depth) stays finite; and in the paper's
  * setting (a spherical light, one planar caster that no other caster
  * overlaps, a kernel that reaches every caster) both variants stay within
- * the error their discretisation predicts. */
+ * the error their discretisation predicts; at its defaults on the project's
+ * scenes (a 1024^2 map) the umbra stays dark (issue 13). */
 #include <math.h>
 #include "soft_helpers.h"
 #include "techniques/backproject.h"
