@@ -256,9 +256,6 @@ static void light_touching(SceneSpec *s, LightKind k, const StabSettings *st)
 
 /* Why techniques miss the closed box's umbra: each reason is its source's. */
 static const KnownLimit inside_occluder_known[] = {
-    {"accumulation", LIGHTS_ALL,
-     "seed 000 assumptions 1-2: a caster nearer the light than the plane n back-projects into the middle of the "
-     "K x K kernel, so walls around the light cover a fraction of it (they would need ~125 lexels; K <= 32)"},
     {"shadow_width", LIGHT_BIT(LIGHT_POINT) | LIGHT_BIT(LIGHT_SPHERE), /* a spot's cone keeps widths small: it meets the limit */
      "seed 003 §3: I = 1 + c_bias - c_scale sw / sd darkens only where the width (capped at 1 / start_difference "
      "texels) is large against the shadow depth; receivers far behind an enclosing wall are only attenuated"},

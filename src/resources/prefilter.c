@@ -666,6 +666,23 @@ void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int 
     *zmax = hi;
 }
 
+float minmax_node_min(const MinMaxPyramid *p, int face, int level, int *i, int *j)
+{
+    *i = clampi(*i, 0, p->size[level] - 1);
+    *j = clampi(*j, 0, p->size[level] - 1);
+    float lo = node(p, level, face, *i, *j)[0];
+    for (int l = level; l > 0; l--) { /* the child holding the minimum, the first in scan order on ties */
+        int below = p->size[l - 1], ci = 2 * *i, cj = 2 * *j;
+        for (int k = 0; k < 4; k++) {
+            int a = clampi(2 * *i + (k & 1), 0, below - 1), b = clampi(2 * *j + (k >> 1), 0, below - 1);
+            if (node(p, l - 1, face, a, b)[0] == lo) { ci = a; cj = b; break; }
+        }
+        *i = ci;
+        *j = cj;
+    }
+    return lo;
+}
+
 /* ---- N-buffer level ---- */
 
 static void buffer_destroy(void *r)

@@ -128,6 +128,11 @@ const MinMaxPyramid *res_minmax_pyramid(ResourceManager *rm, const ShadowMap *ma
 /* Conservative bounds of the stored depth over texels [i0, i1] x [j0, j1]
  * (clamped to the face: the same texels as an edge-clamped window). */
 void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax);
+/* The minimum of node (*i, *j) of `level` (clamped to the level's grid: an
+ * edge-clamped read), and in *i, *j the level-0 texel that holds it, found by
+ * descending through the children (for a test at that texel's own reference:
+ * seed 000's closest caster of a coarse lexel). */
+float minmax_node_min(const MinMaxPyramid *p, int face, int level, int *i, int *j);
 
 /* One level of an N-buffer (Decoret 2005; course ch.4 box "Fast-box Filter
  * Approximations"): the min and max of the stored depth over the 2^level x

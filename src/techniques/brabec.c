@@ -17,8 +17,12 @@
  * The search stops at the first texel found, at the
  * widest penumbra any blocker beyond the near plane can cast, or at the
  * search radius (course §5.2.1's failure: occluders beyond it are ignored).
- * Blockers of the receiver's own object do not count unless self_shadow is
- * on (seed 003 §2: "the algorithm allows no self-shadowing"). */
+ * Blockers of the receiver's own object count (self_shadow, on by default):
+ * the paper's object ids (seed 003 §2: "the algorithm allows no
+ * self-shadowing") kept a surface from shadowing itself without a bias; the
+ * receiver-plane bias does that here, and the ids lose every shadow an
+ * object casts on itself (the bunny's umbra leaked 0.44, the teapot's 0.11;
+ * issue 13). */
 #include <stdlib.h>
 #include "techniques/softmap.h"
 
@@ -37,8 +41,11 @@ static const ParamDesc brabec_params[] = {
     {"falloff", PARAM_ENUM, FALLOFF_SMOOTH, 0, 1, "",
      "visibility across the penumbra: smoothstep (Parker's 3 tau^2 - 2 tau^3, seed 002 §3) or linear",
      falloff_names},
-    {"self_shadow", PARAM_BOOL, 0, 0, 1, "",
-     "let an object's own texels block it (off in the paper: blockers must carry another object id)", NULL},
+    {"self_shadow", PARAM_BOOL, 1, 0, 1, "",
+     "let an object's own texels block it (off in the paper, seed 003 §2: blockers must carry another object id, "
+     "which loses every shadow an object casts on itself; the receiver-plane bias keeps surfaces from shadowing "
+     "themselves)",
+     NULL},
 };
 
 static const char *const brabec_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", NULL};
@@ -196,6 +203,15 @@ static bool outer_limit(const BrabecState *st, const SmapReceiver *r, double a, 
     return true;
 }
 
+/* The texel one step from (i, j) toward (i0, j0), along the larger offset
+ * (both where they tie): the blocked side of the edge the search found. */
+static void edge_blocker(int i, int j, int i0, int j0, int *ei, int *ej)
+{
+    int di = i0 - i, dj = j0 - j, adi = abs(di), adj = abs(dj);
+    *ei = i + (adi >= adj ? (di > 0) - (di < 0) : 0);
+    *ej = j + (adj >= adi ? (dj > 0) - (dj < 0) : 0);
+}
+
 static float visibility(const BrabecState *st, const SmapReceiver *r, int object)
 {
     const SoftFace *f = &st->sm.face[r->mc.face];
@@ -208,11 +224,16 @@ static float visibility(const BrabecState *st, const SmapReceiver *r, int object
         double w = half_width(a, z_p, fmax(softmap_depth(&st->sm, r->mc.face, i, j), z_n));
         return w > 0.0 ? (float)falloff(st->falloff, 0.5 + edge / (2.0 * w)) : 1.0f;
     }
-    /* inner penumbra: p's own blocker sets the width, the nearest unblocked texel the place */
+    /* inner penumbra: the nearest unblocked texel is the place; the blocker at
+     * that edge, the blocked texel next to it on p's side, sets the width */
     double w = half_width(a, z_p, fmax(softmap_depth(&st->sm, r->mc.face, i, j), z_n));
     double limit = fmin(w, st->search_tangent) + search_slack(f);
+    int i0 = i, j0 = j;
     if (!(w > 0.0) || !nearest(st, r, object, false, limit, &edge, &i, &j)) return 0.0f;
-    return (float)falloff(st->falloff, 0.5 - edge / (2.0 * w));
+    int ei, ej;
+    edge_blocker(i, j, i0, j0, &ei, &ej);
+    double w_edge = half_width(a, z_p, fmax(softmap_depth(&st->sm, r->mc.face, ei, ej), z_n));
+    return w_edge > 0.0 ? (float)falloff(st->falloff, 0.5 - edge / (2.0 * w_edge)) : 0.0f;
 }
 
 static void brabec_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
