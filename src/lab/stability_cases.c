@@ -291,7 +291,7 @@ static const KnownLimit inside_occluder_known[] = {
 const KnownLimit *stab_known_limit(const StabCase *c, const Technique *t, LightKind kind)
 {
     for (const KnownLimit *k = c->known; t && k && k->reason; k++)
-        if (strcmp(k->technique, t->name) == 0 && (k->lights & LIGHT_BIT(kind))) return k;
+        if (k->technique && strcmp(k->technique, t->name) == 0 && (k->lights & LIGHT_BIT(kind))) return k;
     return NULL;
 }
 

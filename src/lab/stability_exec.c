@@ -268,6 +268,7 @@ static bool render_hard(Lab *lab, RenderResult *out, Error *e)
     return lab_render(lab, &req, out, e);
 }
 
+/* The metrics over the hard shadow's band of the run's view. */
 static bool band_metrics(Lab *lab, const Image *v, const Reference *ref, const uint8_t *cls, Metrics *band,
                          StabResult *r)
 {
@@ -277,9 +278,12 @@ static bool band_metrics(Lab *lab, const Image *v, const Reference *ref, const u
     size_t count = (size_t)v->width * (size_t)v->height;
     uint8_t *shadowed = malloc(count), *band_cls = malloc(count);
     bool ok = shadowed && band_cls;
-    if (ok) band_classes(&ref->value, &hard.visibility, cls, shadowed, band_cls);
-    ok = ok ? metrics_compute(v, ref, band_cls, band, NULL, &e) || fail(r, "band metrics failed: %s", e.msg)
-            : fail(r, "out of memory for the shadow band");
+    if (!ok) {
+        fail(r, "out of memory for the shadow band");
+    } else {
+        band_classes(&ref->value, &hard.visibility, cls, shadowed, band_cls);
+        ok = metrics_compute(v, ref, band_cls, band, NULL, &e) || fail(r, "band metrics failed: %s", e.msg);
+    }
     free(shadowed);
     free(band_cls);
     render_result_free(&hard);
