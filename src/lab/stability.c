@@ -124,6 +124,14 @@ static bool wanted(const Runner *rn, const char *case_name)
     return included || !any_include;
 }
 
+static StabSettings settings(bool quick)
+{
+    return quick ? (StabSettings){true, STAB_QUICK_WIDTH, STAB_QUICK_HEIGHT, STAB_QUICK_REF_SAMPLES}
+                 : (StabSettings){false, 128, 96, 256};
+}
+
+/* A run of case c (NULL: a parameter probe); a case whose limit is stated
+ * at the full sizes keeps them in quick runs too. */
 static void add_job(Runner *rn, const Technique *t, const StabCase *c, int param, ParamProbe probe, LightKind kind,
                     const char *name)
 {
@@ -134,7 +142,8 @@ static void add_job(Runner *rn, const Technique *t, const StabCase *c, int param
     }
     rn->jobs = jobs;
     StabJob *j = &rn->jobs[rn->num_jobs++];
-    *j = (StabJob){t, c, param, probe, kind, rn->st, rn->threads, rn->order++, ""};
+    StabSettings st = c && c->full_sizes ? settings(false) : rn->st;
+    *j = (StabJob){t, c, param, probe, kind, st, rn->threads, rn->order++, ""};
     snprintf(j->name, sizeof j->name, "%s", name);
 }
 
@@ -461,12 +470,6 @@ static void run_planned(Runner *rn)
 }
 
 /* ---- the suite ----------------------------------------------------------------------- */
-
-static StabSettings settings(bool quick)
-{
-    return quick ? (StabSettings){true, STAB_QUICK_WIDTH, STAB_QUICK_HEIGHT, STAB_QUICK_REF_SAMPLES}
-                 : (StabSettings){false, 128, 96, 256};
-}
 
 bool stab_run(const Technique *const *techs, int n, bool engine_cases, const StabOptions *o, StabRowFn row,
               void *user, Error *err)

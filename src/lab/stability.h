@@ -12,8 +12,10 @@
 #include "techniques/registry.h"
 
 /* STAB_KNOWN: finite and in [0, 1], but short of the case's documented
- * limit for a reason its paper states (stability_cases.c's known limits);
- * neither passed nor failed, and a failure once it meets the limit. */
+ * limit in exactly the quantities an entry for its technique and light kind
+ * lists, for a reason its paper states (stability_cases.c's known limits);
+ * neither passed nor failed, and a failure once it meets the limit or
+ * misses other quantities. */
 typedef enum StabStatus { STAB_PASS, STAB_FAIL, STAB_NOT_APPLICABLE, STAB_KNOWN } StabStatus;
 const char *stab_status_name(StabStatus s);
 

@@ -163,38 +163,61 @@ bool stab_scene_text(const SceneSpec *s, LightKind kind, char *out, size_t n)
 
 /* ---- limits ---------------------------------------------------------------- */
 
+void stab_quantity_names(unsigned q, char *out, size_t n)
+{
+    static const char *const names[STAB_Q_COUNT] = {"band RMSE", "band misclassified", "misclassified",
+                                                    "umbra count", "umbra leak", "umbra lit", "back-facing count",
+                                                    "geometry count", "terminator count"};
+    size_t used = 0;
+    out[0] = '\0';
+    for (int i = 0; i < STAB_Q_COUNT && used < n; i++)
+        if (q & (1u << i)) used += (size_t)snprintf(out + used, n - used, "%s%s", used ? " and " : "", names[i]);
+}
+
 /* Light size 1e-6: the reference equals `hard` there (unit test
  * test_reference_point_limit), so a soft technique must agree with the
- * point-light shadow: MAE <= 0.02 and at most 2% of samples misclassified. */
-#define HARD_LIMIT_MAE 0.02
-#define HARD_LIMIT_MISCLASSIFIED 0.02
+ * point-light shadow where the shadow is: over the hard shadow's band
+ * (StabMeasure) RMSE <= HARD_BAND_RMSE and at most HARD_BAND_MISCLASSIFIED
+ * of its samples misclassified, and at most HARD_MISCLASSIFIED of all lit
+ * candidates (a shadow drawn where neither has one). Over every lit
+ * candidate instead (MAE), a fixed penumbra passed (issue 13: shadow_width,
+ * MAE 0.0137 with RMSE 0.107). Measured at writing (128 x 96, default maps):
+ * sm's own aliasing (1024 texels, nearest texel) band RMSE 0.183, 3.3%
+ * misclassified; every soft technique at most 0.148 and 2.0%; shadow_width
+ * 0.265 and 10.3%. */
+#define HARD_BAND_RMSE 0.2
+#define HARD_BAND_MISCLASSIFIED 0.05
+#define HARD_MISCLASSIFIED 0.02
 
-static bool limit_hard(const Metrics *m, char *why, size_t n)
+static unsigned limit_hard(const StabMeasure *m, char *why, size_t n)
 {
-    const ErrorStats *e = &m->region[REGION_ALL];
-    if (e->mae <= HARD_LIMIT_MAE && e->misclassified <= HARD_LIMIT_MISCLASSIFIED) return true;
-    snprintf(why, n, "does not converge to the hard shadow at light size 1e-6: MAE %.4f (limit %.2f), %.2f%% misclassified (limit %.0f%%)",
-             e->mae, HARD_LIMIT_MAE, 100 * e->misclassified, 100 * HARD_LIMIT_MISCLASSIFIED);
-    return false;
+    const ErrorStats *b = &m->band.region[REGION_ALL], *all = &m->all.region[REGION_ALL];
+    snprintf(why, n, "over the hard shadow's band of %ld samples RMSE %.4f (limit %.2f), %.2f%% misclassified (limit %.0f%%); "
+             "%.2f%% of all lit samples misclassified (limit %.0f%%)",
+             b->count, b->rmse, HARD_BAND_RMSE, 100 * b->misclassified, 100 * HARD_BAND_MISCLASSIFIED,
+             100 * all->misclassified, 100 * HARD_MISCLASSIFIED);
+    return (b->rmse > HARD_BAND_RMSE ? STAB_Q_BAND_RMSE : 0) |
+           (b->misclassified > HARD_BAND_MISCLASSIFIED ? STAB_Q_BAND_MISCLASSIFIED : 0) |
+           (all->misclassified > HARD_MISCLASSIFIED ? STAB_Q_MISCLASSIFIED : 0);
 }
 
 /* Light below the receiver plane: the ground is unlit by shading (back-facing),
  * never a shadow to estimate; only the objects' sides may face the light. */
-static bool limit_no_ground_candidates(const Metrics *m, char *why, size_t n)
+static unsigned limit_no_ground_candidates(const StabMeasure *m, char *why, size_t n)
 {
-    if (m->class_count[SAMPLE_BACKFACING] > 0) return true;
+    if (m->all.class_count[SAMPLE_BACKFACING] > 0) return 0;
     snprintf(why, n, "no back-facing samples: the ground under a light below it was not classified unlit");
-    return false;
+    return STAB_Q_BACKFACING;
 }
 
 /* Light cut by the ground's plane: the ground sees part of it, so its
  * samples are scored as terminator (light.h's convention), never as
  * penumbra of the light's part below the plane. */
-static bool limit_terminator_present(const Metrics *m, char *why, size_t n)
+static unsigned limit_terminator_present(const StabMeasure *m, char *why, size_t n)
 {
-    if (m->region[REGION_TERMINATOR].count > 0) return true;
+    if (m->all.region[REGION_TERMINATOR].count > 0) return 0;
     snprintf(why, n, "no terminator samples: the ground before a light its plane cuts was not flagged");
-    return false;
+    return STAB_Q_TERMINATOR;
 }
 
 /* Light inside the closed box: every lit candidate (the ground, the ball;
@@ -205,30 +228,83 @@ static bool limit_terminator_present(const Metrics *m, char *why, size_t n)
 #define UMBRA_LEAK_MAX 0.02
 #define UMBRA_LIT_MAX 0.01
 
-static bool limit_all_umbra(const Metrics *m, char *why, size_t n)
+static unsigned limit_all_umbra(const StabMeasure *m, char *why, size_t n)
 {
-    const ErrorStats *all = &m->region[REGION_ALL], *umbra = &m->region[REGION_UMBRA];
-    long terminator = m->region[REGION_TERMINATOR].count; /* the ball's band whose plane cuts the light */
+    const ErrorStats *all = &m->all.region[REGION_ALL], *umbra = &m->all.region[REGION_UMBRA];
+    long terminator = m->all.region[REGION_TERMINATOR].count; /* the ball's band whose plane cuts the light */
     if (all->count == 0 || umbra->count + terminator != all->count) {
         snprintf(why, n, "the reference has %ld of %ld lit candidates in umbra (%ld terminator): the light is not enclosed",
                  umbra->count, all->count, terminator);
-        return false;
+        return STAB_Q_UMBRA_COUNT;
     }
     double lit = all->misclassified; /* the reference is 0 throughout: |e| > 0.5 is an estimate > 0.5 */
-    if (all->leak_mean <= UMBRA_LEAK_MAX && lit <= UMBRA_LIT_MAX) return true;
     snprintf(why, n, "light leaks out of the closed box: mean leak %.4f (limit %.2f), %.2f%% of umbra samples lit (limit %.0f%%)",
              all->leak_mean, UMBRA_LEAK_MAX, 100 * lit, 100 * UMBRA_LIT_MAX);
-    return false;
+    return (all->leak_mean > UMBRA_LEAK_MAX ? STAB_Q_UMBRA_LEAK : 0) | (lit > UMBRA_LIT_MAX ? STAB_Q_UMBRA_LIT : 0);
 }
 
 /* No geometry in view: nothing is estimated and nothing may fail. */
-static bool limit_all_background(const Metrics *m, char *why, size_t n)
+static unsigned limit_all_background(const StabMeasure *m, char *why, size_t n)
 {
     long non_bg = 0;
-    for (int c = 1; c < SAMPLE_CLASS_COUNT; c++) non_bg += m->class_count[c];
-    if (non_bg == 0) return true;
+    for (int c = 1; c < SAMPLE_CLASS_COUNT; c++) non_bg += m->all.class_count[c];
+    if (non_bg == 0) return 0;
     snprintf(why, n, "%ld samples hit geometry in a view of the empty sky", non_bg);
-    return false;
+    return STAB_Q_GEOMETRY;
+}
+
+/* Why techniques miss a limit: each entry names its technique, light kinds
+ * and the quantities it misses, with its source's reason; the figures at
+ * writing (full sizes) are in the comments, the row's note has them as run. */
+#define ONE_SIDED (LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_TEXTURED_RECT))
+#define UMBRA_MISSED (STAB_Q_UMBRA_LEAK | STAB_Q_UMBRA_LIT)
+#define ONE_SIDED_MAP                                                                                                \
+    "a one-sided area light's map is one perspective face (course §2.1): receivers in its hemisphere outside that " \
+    "frustum are outside the map, taken as lit"
+
+/* Seed 003 §1 and §3 disregard the light's size and shape: one light sample,
+ * and c_scale alone "adjusts the softness" (its default models one light),
+ * so the penumbra does not shrink with the light. Measured: band RMSE 0.265,
+ * 10.3% of the band misclassified (sphere; 0.261, 10.7% rect, disk,
+ * textured_rect); 1.7% of all lit samples. */
+static const KnownLimit tiny_light_known[] = {
+    {"shadow_width", LIGHTS_AREA, STAB_Q_BAND_RMSE | STAB_Q_BAND_MISCLASSIFIED,
+     "seed 003 §1, §3: one light sample, the light's size disregarded; c_scale alone sets the penumbra's width, "
+     "so it stays that of the light its default models"},
+    {NULL, 0, 0, NULL},
+};
+
+/* Measured: accumulation mean leak 0.99-1.00, 100% lit; shadow_width 0.075
+ * and 8.1% (point, sphere); under one-sided lights every map technique
+ * 0.216-0.228 and 21.6-22.5% lit. */
+static const KnownLimit inside_occluder_known[] = {
+    {"accumulation", LIGHTS_AREA, UMBRA_MISSED,
+     "seed 000 assumptions 1-2: a caster nearer the light than the plane n back-projects into the middle of the "
+     "K x K kernel, so walls around the light cover a fraction of it (they would need ~125 lexels; K <= 32)"},
+    {"shadow_width", LIGHT_BIT(LIGHT_POINT) | LIGHT_BIT(LIGHT_SPHERE), UMBRA_MISSED, /* a spot's cone keeps widths small: it meets the limit */
+     "seed 003 §3: I = 1 + c_bias - c_scale sw / sd darkens only where the width (capped at 1 / start_difference "
+     "texels) is large against the shadow depth; receivers far behind an enclosing wall are only attenuated"},
+    {"sm", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {"pcf", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {"vsm", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {"lvsm", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {"evsm", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {"msm", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {"esm", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {"csm", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {"brabec", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
+    {"pcss", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
+    {"adaptive_area", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_TEXTURED_RECT), UMBRA_MISSED, ONE_SIDED_MAP},
+    {"shadow_width", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {"aliasing", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {NULL, 0, 0, NULL},
+};
+
+const KnownLimit *stab_known_limit(const StabCase *c, const Technique *t, LightKind kind)
+{
+    for (const KnownLimit *k = c->known; t && k && k->reason; k++)
+        if (k->technique && strcmp(k->technique, t->name) == 0 && (k->lights & LIGHT_BIT(kind))) return k;
+    return NULL;
 }
 
 /* ---- light cases ------------------------------------------------------------ */
@@ -252,26 +328,6 @@ static void light_touching(SceneSpec *s, LightKind k, const StabSettings *st)
     (void)st;
     set3(s->light_pos, 0, k == LIGHT_SPHERE ? 1.4 + s->light_size : 1.4, 0);
     set3(s->light_aim, 0.5, 0, 0.5);
-}
-
-/* Why techniques miss the closed box's umbra: each reason is its source's. */
-static const KnownLimit inside_occluder_known[] = {
-    {"shadow_width", LIGHT_BIT(LIGHT_POINT) | LIGHT_BIT(LIGHT_SPHERE), /* a spot's cone keeps widths small: it meets the limit */
-     "seed 003 §3: I = 1 + c_bias - c_scale sw / sd darkens only where the width (capped at 1 / start_difference "
-     "texels) is large against the shadow depth; receivers far behind an enclosing wall are only attenuated"},
-    {NULL, LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_TEXTURED_RECT),
-     "a one-sided area light's map is one perspective face (course §2.1): receivers in its hemisphere outside "
-     "that frustum are outside the map, taken as lit"},
-    {NULL, 0, NULL},
-};
-
-const KnownLimit *stab_known_limit(const StabCase *c, const Technique *t, LightKind kind)
-{
-    for (const KnownLimit *k = c->known; t && k && k->reason; k++) {
-        bool tech = k->technique ? strcmp(k->technique, t->name) == 0 : tech_acquires(t, "shadow_map");
-        if (tech && (k->lights & LIGHT_BIT(kind))) return k;
-    }
-    return NULL;
 }
 
 static void light_inside_occluder(SceneSpec *s, LightKind k, const StabSettings *st)
@@ -662,8 +718,9 @@ static void in_triangle_budget(SceneSpec *s, LightKind k, const StabSettings *st
 #define DIRECTIONAL LIGHT_BIT(LIGHT_DIRECTIONAL)
 
 static const StabCase cases[] = {
-    {"light_size_1e-6", GROUP_LIGHT, "area light of size 1e-6: converges to the hard shadow (MAE <= 0.02, <= 2% misclassified)",
-     AREA, PLAN_EACH, false, false, true, light_tiny, limit_hard, {0}, NULL},
+    {"light_size_1e-6", GROUP_LIGHT,
+     "area light of size 1e-6: converges to the hard shadow where it is (band RMSE <= 0.2, <= 5% misclassified)",
+     AREA, PLAN_EACH, false, false, true, light_tiny, limit_hard, {0}, tiny_light_known},
     {"light_larger_than_scene", GROUP_LIGHT, "area light of size 100 (a sphere light containing the whole scene)",
      AREA, PLAN_EACH, false, false, false, light_huge, NULL, {0}, NULL},
     {"light_touching_occluder", GROUP_LIGHT, "light centre on the box's top face (a sphere light resting on it)",

@@ -46,6 +46,33 @@ typedef struct StabSettings {
     int ref_samples;
 } StabSettings;
 
+/* What a case's limit reads: the metrics over every lit candidate, and over
+ * the hard shadow's band (stability_exec.c): the lit candidates where the
+ * reference or `hard` is below metrics.h's lit bound, and every lit
+ * candidate within STAB_BAND_PX view pixels of one. */
+#define STAB_BAND_PX 2
+typedef struct StabMeasure {
+    Metrics all;
+    Metrics band;
+} StabMeasure;
+
+/* What a limit measures, as bits: the quantities a row missed, and those a
+ * known entry expects it to miss. */
+typedef enum StabQuantity {
+    STAB_Q_BAND_RMSE = 1u << 0,          /* RMSE over the hard shadow's band */
+    STAB_Q_BAND_MISCLASSIFIED = 1u << 1, /* the band's share misclassified (|e| > 0.5) */
+    STAB_Q_MISCLASSIFIED = 1u << 2,      /* the share of all lit candidates misclassified */
+    STAB_Q_UMBRA_COUNT = 1u << 3,        /* lit candidates outside the reference's umbra */
+    STAB_Q_UMBRA_LEAK = 1u << 4,         /* mean light leaked over the umbra */
+    STAB_Q_UMBRA_LIT = 1u << 5,          /* the umbra's share estimated lit (> 0.5) */
+    STAB_Q_BACKFACING = 1u << 6,         /* back-facing samples (none: the limit is missed) */
+    STAB_Q_GEOMETRY = 1u << 7,           /* samples that hit geometry */
+    STAB_Q_TERMINATOR = 1u << 8,         /* samples flagged terminator (none: the limit is missed) */
+    STAB_Q_COUNT = 9
+} StabQuantity;
+/* The names of the quantities in `q`, joined by " and ". */
+void stab_quantity_names(unsigned q, char *out, size_t n);
+
 typedef enum CaseGroup { GROUP_LIGHT, GROUP_GEOMETRY, GROUP_CAMERA, GROUP_INPUT } CaseGroup;
 
 /* Which of the technique's light kinds a case runs with. */
@@ -64,21 +91,25 @@ typedef struct StabCase {
     LightPlan plan;
     bool heavy;                    /* reduced reference samples */
     bool may_refuse;               /* a technique may refuse it with a clear message */
-    bool default_maps;             /* its limit is stated at the default map sizes: quick runs keep them */
+    bool full_sizes;               /* its limit is stated at the full matrix's sizes (view, reference
+                                    * samples, maps): quick runs keep them */
     void (*build)(SceneSpec *s, LightKind kind, const StabSettings *st);
-    /* Documented limit on the metrics against the reference; NULL: none.
-     * Returns false with the reason in `why`. */
-    bool (*limit)(const Metrics *m, char *why, size_t n);
+    /* Documented limit on the measurements against the reference; NULL:
+     * none. Returns the StabQuantity bits it missed (0: met), the figures
+     * in `why`. */
+    unsigned (*limit)(const StabMeasure *m, char *why, size_t n);
     const char *refusal[3];        /* PLAN_NONE: words the refusal must contain */
     const struct KnownLimit *known;/* techniques known to miss `limit` here; ends at a NULL reason */
 } StabCase;
 
-/* A technique (NULL: every technique that acquires a shadow map) that
- * misses a case's limit under the given light kinds for a reason its
- * source states: its rows are STAB_KNOWN, and STAB_FAIL if the limit holds. */
+/* A technique that misses a case's limit under the given light kinds, in
+ * exactly the quantities `misses` (StabQuantity bits), for a reason its
+ * source states: its rows are STAB_KNOWN; a row that meets the limit or
+ * misses other quantities is STAB_FAIL. */
 typedef struct KnownLimit {
     const char *technique;
     unsigned lights;
+    unsigned misses;
     const char *reason;
 } KnownLimit;
 const KnownLimit *stab_known_limit(const StabCase *c, const Technique *t, LightKind kind);

@@ -1,6 +1,8 @@
 #!/bin/sh
 # run.sh -- command-line tests: exit statuses, messages, outputs, cache use.
-# Usage: tests/cli/run.sh build/shadowlab. Prints "cli: N passed, N failed".
+# Usage: tests/cli/run.sh build/shadowlab. Prints "cli: N passed, N failed",
+# after "cli: N skipped" when a check could not run here (neither passed
+# nor failed).
 set -u
 SL=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
@@ -10,23 +12,26 @@ trap 'rm -rf "$TMP"' EXIT
 export SHADOWLAB_CACHE="$TMP/cache"
 pass=0
 fail=0
+skipped=0
 
 ok() { pass=$((pass + 1)); echo "ok   $1"; }
 no() { fail=$((fail + 1)); echo "FAIL $1: $2"; sed 's/^/    /' "$TMP/err" | head -5; }
+skip() { skipped=$((skipped + 1)); echo "skip $1: $2"; }
 
-# expect NAME STATUS WORDS... -- COMMAND...: exit status and words in stderr+stdout
+# expect NAME STATUS PHRASES... -- COMMAND...: exit status, and each phrase
+# (a grep pattern, spaces included) in stderr+stdout
 expect() {
     name=$1; want=$2; shift 2
-    words=""
-    while [ "$1" != "--" ]; do words="$words|$1"; shift; done
+    : >"$TMP/phrases"
+    while [ "$1" != "--" ]; do printf '%s\n' "$1" >>"$TMP/phrases"; shift; done
     shift
     "$@" >"$TMP/out" 2>"$TMP/err"
     got=$?
     cat "$TMP/out" >>"$TMP/err"
     if [ "$got" -ne "$want" ]; then no "$name" "exit $got, expected $want"; return; fi
-    for w in $(echo "${words#|}" | tr '|' ' '); do
-        if ! grep -q -- "$w" "$TMP/err"; then no "$name" "output lacks '$w'"; return; fi
-    done
+    while IFS= read -r phrase; do
+        if ! grep -q -- "$phrase" "$TMP/err"; then no "$name" "output lacks '$phrase'"; return; fi
+    done <"$TMP/phrases"
     ok "$name"
 }
 
@@ -76,7 +81,7 @@ expect list_shows_hard 0 "hard" "offset_scale" "course" -- "$SL" list
 "$SL" list --json >"$TMP/list.json" 2>"$TMP/err"
 if command -v python3 >/dev/null && python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert any(t["name"]=="hard" for t in d)' "$TMP/list.json" 2>>"$TMP/err"; then
     ok list_json_parses
-elif ! command -v python3 >/dev/null; then ok list_json_parses_skipped_no_python; else no list_json_parses "invalid JSON"; fi
+elif ! command -v python3 >/dev/null; then skip list_json_parses "no python3"; else no list_json_parses "invalid JSON"; fi
 
 # Each command takes exactly the options that act on it, and its --help lists
 # exactly those: every option any --help lists is parsed by the commands that
@@ -180,7 +185,7 @@ if command -v script >/dev/null && script -qec true /dev/null >/dev/null 2>&1; t
         n=$((n * 4))
     done
     tr '\r' '\n' <"$TMP/pty" >"$TMP/pty-lines"
-    if [ "$conclusive" -eq 0 ]; then ok progress_on_a_terminal_skipped_runs_too_fast
+    if [ "$conclusive" -eq 0 ]; then skip progress_line_on_a_terminal_after_a_second "every run took under 2 s"
     elif grep -q "^render hard > evaluate [0-9]*/$n, [0-9.]* s" "$TMP/pty-lines"; then ok progress_line_on_a_terminal_after_a_second
     else no progress_line_on_a_terminal_after_a_second "no 'render hard > evaluate k/$n' in: $(head -3 "$TMP/pty-lines")"; fi
     # erased before the table: blanks over the last progress text, then the table
@@ -189,11 +194,11 @@ if command -v script >/dev/null && script -qec true /dev/null >/dev/null 2>&1; t
         else no progress_line_erased_before_the_table "the table does not follow an erased line"; fi
     fi
     t0=$(now); script -qec "$SL render $SCENE -t hard --no-png $SMALL -o $TMP/progress" /dev/null >"$TMP/pty" 2>&1; t1=$(now)
-    if longer "$t0" "$t1" 0.8; then ok progress_none_for_short_work_skipped_machine_slow
+    if longer "$t0" "$t1" 0.8; then skip progress_none_for_short_work "the short run took over 0.8 s"
     elif grep -q "render hard >" "$TMP/pty"; then no progress_none_for_short_work "drawn for a run under a second"
     else ok progress_none_for_short_work; fi
 else
-    ok progress_on_a_terminal_skipped_no_script
+    skip progress_line_on_a_terminal_after_a_second "no script(1) to make a terminal"
     n=400
 fi
 $LONG --repeat "$n" >"$TMP/out" 2>"$TMP/err"
@@ -249,5 +254,6 @@ if [ "$(ls "$TMP/outdirs/reports" 2>/dev/null | grep -c '^sphere-on-plane-[0-9a-
     ok outputs_of_different_scene_states_do_not_share_a_folder
 else no outputs_of_different_scene_states_do_not_share_a_folder "folders: $dirs"; fi
 
+[ "$skipped" -eq 0 ] || echo "cli: $skipped skipped"
 echo "cli: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -49,7 +49,10 @@ TEST(test_filtered_do_as_well_as_pcf_under_one_occluder)
         const Technique *t = tech_at(i);
         if (!filtered_acquires_moments(t)) continue;
         Scored s = score(lab, t->name, p);
-        CHECK(s.ok && s.m.nonfinite == 0 && s.m.out_of_range == 0);
+        /* Out-of-range values cannot get out: each technique clamps its
+         * result to [0, 1] (vsm.c and csm.c with comparisons, which NaN
+         * passes; esm.c with fmin, which would turn NaN into 1). */
+        CHECK_MSG(s.ok && s.m.nonfinite == 0, "%s: %ld non-finite values", t->name, s.m.nonfinite);
         /* Measured within 0.001 of PCF's RMSE (0.038) and umbra leaks up to
          * 0.004 (CSM's ringing): bounds of 0.005 and 0.01. */
         CHECK_MSG(fabs(s.m.region[REGION_ALL].rmse - pcf.m.region[REGION_ALL].rmse) < 0.005, "%s: rmse %.4f, pcf %.4f",

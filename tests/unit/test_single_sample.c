@@ -484,10 +484,11 @@ static int outer_built(Lab *lab)
     return -1;
 }
 
-/* The outer objects depend on the casters only (b is formed per ray):
- * reused across combine, falloff and offset, for another light of the same
- * size and for one of another size; rebuilt with analytic spheres off. */
-TEST(test_single_sample_outer_objects_keyed_by_casters_and_light_size)
+/* The outer objects depend on the casters only (b is formed per ray), not
+ * on the light: reused across combine, falloff and offset, for another light
+ * of the same size and for one of another size; rebuilt with analytic
+ * spheres off. */
+TEST(test_single_sample_outer_objects_keyed_by_casters_not_light_size)
 {
     Lab *lab = fixture_lab("lights.lua",
                            "return {\n"
