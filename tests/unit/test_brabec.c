@@ -37,9 +37,10 @@ TEST(test_brabec_is_close_to_the_reference_at_a_straight_edge)
 /* A ring lit from the side (only the ring receives) and the bunny: shadows
  * an object casts on itself. With the paper's object ids (self_shadow=false)
  * such an umbra is lit: 1.00 on the ring, 0.44 on the bunny (issue 13). At
- * the defaults its own texels block it; the ring's umbra is a thin band
- * whose inner-penumbra rule still leaks near its edges (0.09 measured). 160 x
- * 120, 64 reference samples. */
+ * the defaults its own texels block it. The ring's umbra is a thin band (59
+ * samples since the horizon convention scores the band whose tangent plane
+ * cuts the light as terminator; its leak there 0.0000, 0.09 before when the
+ * terminator band counted as umbra). 160 x 120, 64 reference samples. */
 TEST(test_brabec_defaults_let_an_object_shadow_itself)
 {
     Lab *labs[2] = {
@@ -62,7 +63,7 @@ TEST(test_brabec_defaults_let_an_object_shadow_itself)
         printf("    %s: umbra %ld samples, leak %.4f (object ids %.4f); penumbra RMSE %.4f (%.4f)\n",
                k ? "bunny" : "ring", u->count, u->leak_mean, mo.region[REGION_UMBRA].leak_mean,
                m.region[REGION_PENUMBRA].rmse, mo.region[REGION_PENUMBRA].rmse);
-        CHECK(u->count > 100);
+        CHECK(u->count > 40);
         CHECK_MSG(u->leak_mean < bound[k], "umbra leak %.4f at the defaults, above %.2f", u->leak_mean, bound[k]);
         CHECK_MSG(mo.region[REGION_UMBRA].leak_mean > 0.3, "self_shadow=false no longer ignores the object's own texels");
         render_result_free(&r);
