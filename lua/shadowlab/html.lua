@@ -71,7 +71,7 @@ local function results_table(doc, out)
         '<td class="n">%s</td><td class="n">%s</td><td>%s</td><td>%s</td><td>%s</td></tr>',
         r.on_front and ' class="front"' or "", r.index, where, esc(r.label), num(doc.err(r), "%.5f"),
         num(m.penumbra.rmse, "%.5f"), num(m.all.mae, "%.5f"), num(m.all.misclassified, "%.4f"),
-        num(m.noise_rms, "%.5f"), num(1e3 * t[doc.time], "%.3f"), num(1e3 * t.evaluate_median, "%.3f"),
+        num(m.all.noise_rms, "%.5f"), num(1e3 * t[doc.time], "%.3f"), num(1e3 * t.evaluate_median, "%.3f"),
         num(1e3 * t.evaluate_min, "%.3f"), num(1e3 * t.technique_build, "%.3f"), esc(rec.resource_cache),
         esc(rec.reference.origin), esc(params_text(r)))
     end

@@ -37,6 +37,28 @@ bool sampling_check_count(SamplingPattern p, int count, Error *err)
     return true;
 }
 
+int sampling_batches(SamplingPattern p, int count)
+{
+    switch (p) {
+    case SAMPLING_R2: return count < SAMPLING_MAX_BATCHES ? count : SAMPLING_MAX_BATCHES;
+    case SAMPLING_STRATIFIED: {
+        int m = isqrt(count); /* a square count: batches d^2 of (m/d)^2 samples each */
+        for (int d = 4; d > 1; d--)
+            if (m % d == 0) return d * d;
+        return 1;
+    }
+    case SAMPLING_RANDOM: break;
+    }
+    return 1;
+}
+
+/* First index of batch b of m over `count` samples. */
+static int batch_first(int b, int m, int count) { return (int)((long long)b * count / m); }
+
+static int batch_of(int i, int m, int count) { return (int)(((long long)(i + 1) * m - 1) / count); }
+
+int sampling_batch_of(SamplingPattern p, int i, int count) { return batch_of(i, sampling_batches(p, count), count); }
+
 uint32_t sampling_stream(uint32_t seed, uint32_t id) { return hash_u32(id ^ hash_u32(seed + 0x9e3779b9u)); }
 
 /* 24 random bits to a float in [0,1). */
@@ -46,20 +68,23 @@ static float frac(double x) { return (float)(x - floor(x)); }
 
 void sample_2d(SamplingPattern p, uint32_t stream, int i, int count, float *u, float *v)
 {
+    int m = sampling_batches(p, count), b = batch_of(i, m, count), first = batch_first(b, m, count);
+    int j = i - first, n = batch_first(b + 1, m, count) - first; /* index and size within the batch */
+    uint32_t bs = b == 0 ? stream : hash_u32(stream ^ (0x85ebca6bu * (uint32_t)b)); /* the batch's own stream */
     uint32_t hu = hash_u32(stream ^ (2u * (uint32_t)i)), hv = hash_u32(stream ^ (2u * (uint32_t)i + 1u) ^ 0x68e31da4u);
     switch (p) {
     case SAMPLING_R2: {
         const double a1 = 0.7548776662466927, a2 = 0.5698402909980532; /* 1/phi2, 1/phi2^2 */
-        double su = unit_float(hash_u32(stream)), sv = unit_float(hash_u32(stream ^ 0x5bd1e995u));
-        *u = frac(su + a1 * (double)i);
-        *v = frac(sv + a2 * (double)i);
+        double su = unit_float(hash_u32(bs)), sv = unit_float(hash_u32(bs ^ 0x5bd1e995u)); /* the batch's shift */
+        *u = frac(su + a1 * (double)j);
+        *v = frac(sv + a2 * (double)j);
         break;
     }
     case SAMPLING_STRATIFIED: {
-        int m = isqrt(count);
-        int cx = i % m, cy = i / m;
-        *u = ((float)cx + unit_float(hu)) / (float)m;
-        *v = ((float)cy + unit_float(hv)) / (float)m;
+        int side = isqrt(n); /* the batch's own jittered side x side grid */
+        int cx = j % side, cy = j / side;
+        *u = ((float)cx + unit_float(hu)) / (float)side;
+        *v = ((float)cy + unit_float(hv)) / (float)side;
         break;
     }
     case SAMPLING_RANDOM:

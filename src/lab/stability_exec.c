@@ -236,7 +236,7 @@ static bool measure(const StabJob *j, Lab *lab, const Image *v, const uint8_t *c
     Metrics m;
     if (!metrics_compute(v, ref, cls, &m, NULL, &e)) return fail(r, "metrics failed: %s", e.msg);
     r->ref_samples = light_is_delta(&lab_scene(lab)->lights[0]) ? 1 : rq.params.samples;
-    r->noise_rms = m.noise_rms;
+    r->noise_rms = m.region[REGION_ALL].noise_rms;
     if (m.region[REGION_ALL].count > 0) {
         r->mae = m.region[REGION_ALL].mae;
         r->rmse = m.region[REGION_ALL].rmse;

@@ -38,10 +38,20 @@ int reference_channels(const Scene *scene, int light_index, Measure m)
     return (m == MEASURE_IRRADIANCE || scene->lights[light_index].kind == LIGHT_TEXTURED_RECT) ? 3 : 1;
 }
 
-/* Running sums of one view sample's estimator, per colour channel. */
+const char *ref_error_estimator_name(RefErrorEstimator e)
+{
+    static const char *const names[REF_ERROR_ESTIMATOR_COUNT] = {"exact", "independent", "rqmc"};
+    return names[e];
+}
+
+/* Running sums of one view sample's estimator, per batch (core/sampling's
+ * independent randomisations) and colour channel: weights W and weighted
+ * values X. Visibility: w the light sample's colour weight, x 1 (lit) or 0;
+ * irradiance: w 1, x the sample's contribution. */
 typedef struct Accum {
-    double w[3], wv[3], w2[3]; /* visibility: weights, weighted hits, squared weights */
-    double c[3], c2[3];        /* irradiance: contributions and their squares */
+    double w[SAMPLING_MAX_BATCHES][3], x[SAMPLING_MAX_BATCHES][3];
+    double w2[3]; /* squared weights: the binomial's n_eff */
+    double x2[3]; /* squared values: independent samples' variance (irradiance, w = 1) */
     int n;
 } Accum;
 
@@ -78,64 +88,102 @@ static void fill_batch(Batch *b, const Light *l, vec3 org, vec3 p, uint32_t stre
     }
 }
 
-/* Visibility sums of the `nc` channels the reference stores. */
-static void accumulate_visibility(Accum *a, const Batch *b, int nc)
+static void add_sample(Accum *a, int batch, const float *w, const double *x, int nc)
+{
+    for (int c = 0; c < nc; c++) {
+        a->w[batch][c] += w[c];
+        a->x[batch][c] += w[c] * x[c];
+        a->w2[c] += (double)w[c] * w[c];
+        a->x2[c] += x[c] * x[c];
+    }
+    a->n++;
+}
+
+/* Visibility of the `nc` channels the reference stores; samples first ..
+ * first + 15 of `count`. */
+static void accumulate_visibility(Accum *a, const Batch *b, SamplingPattern pat, int first, int count, int nc)
 {
     for (int k = 0; k < PACKET; k++) {
         if (!b->valid[k]) continue;
         const LightSample *s = &b->ls[k];
-        float vis = b->ray.tfar[k] == -INFINITY ? 0.0f : 1.0f; /* Embree marks occluded rays with tfar = -inf */
+        double vis = b->ray.tfar[k] == -INFINITY ? 0.0 : 1.0; /* Embree marks occluded rays with tfar = -inf */
         const float w[3] = {s->vis_weight.x, s->vis_weight.y, s->vis_weight.z};
-        for (int c = 0; c < nc; c++) {
-            a->w[c] += w[c];
-            a->wv[c] += w[c] * vis;
-            a->w2[c] += (double)w[c] * w[c];
-        }
-        a->n++;
+        const double x[3] = {vis, vis, vis};
+        add_sample(a, sampling_batch_of(pat, first + k, count), w, x, nc);
     }
 }
 
 /* Lambertian direct illumination, course Eq. 1.3: E cos / pi per sample. */
-static void accumulate_irradiance(Accum *a, const Batch *b, vec3 n_shading, vec3 albedo)
+static void accumulate_irradiance(Accum *a, const Batch *b, SamplingPattern pat, int first, int count,
+                                  vec3 n_shading, vec3 albedo)
 {
+    static const float unit[3] = {1.0f, 1.0f, 1.0f};
     for (int k = 0; k < PACKET; k++) {
         if (!b->valid[k]) continue;
         const LightSample *s = &b->ls[k];
         float vis = b->ray.tfar[k] == -INFINITY ? 0.0f : 1.0f;
         float cos_p = fmaxf(0.0f, v3_dot(n_shading, s->dir_world));
         const float e[3] = {s->irradiance.x * albedo.x, s->irradiance.y * albedo.y, s->irradiance.z * albedo.z};
-        for (int c = 0; c < 3; c++) {
-            double contrib = e[c] * cos_p * vis * INV_PI;
-            a->c[c] += contrib;
-            a->c2[c] += contrib * contrib;
-        }
-        a->n++;
+        double x[3];
+        for (int c = 0; c < 3; c++) x[c] = e[c] * cos_p * vis * INV_PI;
+        add_sample(a, sampling_batch_of(pat, first + k, count), unit, x, 3);
     }
 }
 
-/* Visibility with a Laplace-smoothed binomial standard error, p~ = (k+1)/(n+2)
- * in weighted form, so an all-lit or all-blocked sample still reports the
- * uncertainty of n draws; n_eff = (sum w)^2 / sum w^2 for weighted samples. */
-static void finish_visibility(const Accum *a, float *value, float *se, int nc)
+/* Standard error of the ratio estimate mean = X / W from m independent
+ * batches (Cochran 1977, Sampling Techniques, Eq. 6.13 over clusters; with
+ * equal weights the batch means' standard deviation over sqrt(m), L'Ecuyer &
+ * Lemieux 2002 §2): se^2 = m / (m - 1) sum_b (X_b - W_b mean)^2 / W^2. It is
+ * 0 where every batch agrees: no smoothing floor. W > 0, m > 1. */
+static double batch_spread(const Accum *a, int c, int m, double mean, double w)
 {
+    double sq = 0;
+    for (int b = 0; b < m; b++) {
+        double d = a->x[b][c] - a->w[b][c] * mean;
+        sq += d * d;
+    }
+    return sqrt(sq * m / (m - 1)) / w;
+}
+
+static double channel_sum(const double (*v)[3], int m, int c)
+{
+    double s = 0;
+    for (int b = 0; b < m; b++) s += v[b][c];
+    return s;
+}
+
+/* Independent samples' visibility error: the Laplace-smoothed binomial, p~ =
+ * (k+1)/(n+2) in weighted form, so an all-lit or all-blocked sample still
+ * reports the uncertainty of n draws; n_eff = (sum w)^2 / sum w^2. */
+static double binomial_error(const Accum *a, int c, double w, double wx)
+{
+    double mean_w = w / a->n;
+    double p_s = (wx + mean_w) / (w + 2.0 * mean_w);
+    double n_eff = w * w / a->w2[c];
+    return sqrt(p_s * (1.0 - p_s) / n_eff);
+}
+
+/* Independent samples' irradiance error: sample variance over n (w = 1). */
+static double sample_variance_error(const Accum *a, int c, double mean)
+{
+    if (a->n < 2) return 0.0;
+    double var = fmax(0.0, (a->x2[c] / a->n - mean * mean) * a->n / (a->n - 1));
+    return sqrt(var / a->n);
+}
+
+/* Value and standard error per channel, by the reference's estimator (m batches). */
+static void finish(const Accum *a, const Reference *ref, int nc, float *value, float *se)
+{
+    int m = ref->batches;
+    bool irradiance = ref->params.measure == MEASURE_IRRADIANCE;
     for (int c = 0; c < nc; c++) {
-        if (a->w[c] <= 0.0) { value[c] = 1.0f; se[c] = 0.0f; continue; } /* a black light texel set: nothing to block */
-        double mean_w = a->w[c] / a->n;
-        double p = a->wv[c] / a->w[c];
-        double p_s = (a->wv[c] + mean_w) / (a->w[c] + 2.0 * mean_w);
-        double n_eff = a->w[c] * a->w[c] / a->w2[c];
-        value[c] = (float)p;
-        se[c] = (float)sqrt(p_s * (1.0 - p_s) / n_eff);
-    }
-}
-
-static void finish_irradiance(const Accum *a, float *value, float *se)
-{
-    for (int c = 0; c < 3; c++) {
-        double mean = a->c[c] / a->n;
-        double var = a->n > 1 ? fmax(0.0, (a->c2[c] / a->n - mean * mean) * a->n / (a->n - 1)) : 0.0;
+        double w = channel_sum(a->w, m, c), wx = channel_sum(a->x, m, c);
+        if (w <= 0.0) { value[c] = 1.0f; se[c] = 0.0f; continue; } /* a black light texel set: nothing to block */
+        double mean = wx / w;
         value[c] = (float)mean;
-        se[c] = (float)sqrt(var / a->n);
+        if (ref->estimator == REF_ERROR_EXACT) se[c] = 0.0f;
+        else if (ref->estimator == REF_ERROR_RQMC) se[c] = (float)batch_spread(a, c, m, mean, w);
+        else se[c] = (float)(irradiance ? sample_variance_error(a, c, mean) : binomial_error(a, c, w, wx));
     }
 }
 
@@ -161,12 +209,11 @@ static void trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx
         fill_batch(b, j->light, org, p, stream, first, j->count, j->p);
         rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
         if (j->p->measure == MEASURE_IRRADIANCE)
-            accumulate_irradiance(&a, b, j->vs->n_shading_world[s], j->scene->objects[j->vs->object[s]].albedo);
-        else accumulate_visibility(&a, b, nc);
+            accumulate_irradiance(&a, b, j->p->pattern, first, j->count, j->vs->n_shading_world[s],
+                                  j->scene->objects[j->vs->object[s]].albedo);
+        else accumulate_visibility(&a, b, j->p->pattern, first, j->count, nc);
     }
-    float *v = j->out->value.data + (size_t)s * nc, *se = j->out->std_error.data + (size_t)s * nc;
-    if (j->p->measure == MEASURE_IRRADIANCE) finish_irradiance(&a, v, se);
-    else finish_visibility(&a, v, se, nc);
+    finish(&a, j->out, nc, j->out->value.data + (size_t)s * nc, j->out->std_error.data + (size_t)s * nc);
 }
 
 /* Value of samples that are not traced: unlit (0) unless on a non-receiver,
@@ -200,8 +247,10 @@ bool reference_compute(const RtScene *casters, const Scene *scene, int light_ind
     }
     out->params = *p;
     const Light *l = &scene->lights[light_index];
-    RefJob j = {rt_scene_handle(casters), scene, l, vs, p, light_is_delta(l) ? 1 : p->samples,
-                scene_extent(scene), out};
+    out->rays_per_sample = light_is_delta(l) ? 1 : p->samples;
+    out->batches = sampling_batches(p->pattern, out->rays_per_sample);
+    out->estimator = light_is_delta(l) ? REF_ERROR_EXACT : out->batches > 1 ? REF_ERROR_RQMC : REF_ERROR_INDEPENDENT;
+    RefJob j = {rt_scene_handle(casters), scene, l, vs, p, out->rays_per_sample, scene_extent(scene), out};
     Progress prog;
     progress_begin(&prog, "reference", vs->height);
     long long rays = 0;

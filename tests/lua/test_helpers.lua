@@ -274,7 +274,7 @@ end)
 
 local function fake_row(scene, samples, noise)
   return { record = { scene = { name = scene, width = 40, height = 30 }, reference = { samples = samples },
-                      metrics = { noise_rms = noise } } }
+                      metrics = { all = { noise_rms = noise } } } }
 end
 
 local function read_all(path)
