@@ -153,3 +153,32 @@ TEST(test_calibration_metrics_regions_noise_and_nonfinite)
     image_free(&sig);
     reference_free(&ref);
 }
+
+/* The reference cache keeps how the error was estimated (format version 2). */
+TEST(test_calibration_cache_keeps_the_estimator)
+{
+    char cache[1024];
+    snprintf(cache, sizeof cache, "%s/cache", test_tmpdir());
+    Reference got[2];
+    RefOrigin origin[2];
+    for (int k = 0; k < 2; k++) { /* a fresh lab each time, as a new process */
+        Error err;
+        Lab *lab = fixture_lab("cached.lua", penumbra_scene);
+        CHECK(lab);
+        RefInfo info;
+        RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_STRATIFIED, 3}, cache};
+        const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
+        CHECK_MSG(ref, "%s", err.msg);
+        got[k] = (Reference){.rays_per_sample = ref->rays_per_sample, .estimator = ref->estimator,
+                             .batches = ref->batches};
+        origin[k] = info.origin;
+        lab_close(lab);
+    }
+    printf("    %s then %s: estimator %s, %d batches, %d rays per sample\n", ref_origin_name(origin[0]),
+           ref_origin_name(origin[1]), ref_error_estimator_name(got[1].estimator), got[1].batches,
+           got[1].rays_per_sample);
+    CHECK(origin[0] == REF_COMPUTED && origin[1] == REF_CACHE_HIT);
+    CHECK(got[0].estimator == REF_ERROR_RQMC && got[0].batches == 16 && got[0].rays_per_sample == 64);
+    CHECK(got[1].estimator == got[0].estimator && got[1].batches == got[0].batches &&
+          got[1].rays_per_sample == got[0].rays_per_sample);
+}
