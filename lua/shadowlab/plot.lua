@@ -75,14 +75,17 @@ function plot.caption(rows, sep, noise)
       groups[id] = { samples = {}, noise = {} }
       order[#order + 1] = id
     end
-    table.insert(groups[id].samples, rec.reference.samples)
+    -- a delta light's reference traces one exact ray whatever the samples asked
+    if rec.reference.std_error == "exact" then groups[id].exact = true
+    else table.insert(groups[id].samples, rec.reference.samples) end
     table.insert(groups[id].noise, noise.value(rec))
   end
   local parts = {}
   for i, id in ipairs(order) do
     local g = groups[id]
-    parts[i] = string.format("%s, reference %s samples, %s %s", id, range_text(g.samples, "%d"), noise.label,
-                             range_text(g.noise, "%.4f"))
+    local samples = #g.samples > 0 and range_text(g.samples, "%d") .. " samples" or nil
+    if g.exact then samples = (samples and samples .. " and " or "") .. "one exact ray (delta light)" end
+    parts[i] = string.format("%s, reference %s, %s %s", id, samples, noise.label, range_text(g.noise, "%.4f"))
   end
   return table.concat(parts, sep or "; ")
 end

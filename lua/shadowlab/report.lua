@@ -214,10 +214,11 @@ local function along_axis(ctx, axis, scene_rows, name, what)
   for _, s in ipairs(series_along(axis, scene_rows)) do
     local pts = {}
     for _, r in ipairs(s.rows) do
-      local y = what == "error" and ctx.err(r) or 1e3 * r.record.timings_s[ctx.time]
+      local y -- nil for an empty region: the point is left out
+      if what == "error" then y = ctx.err(r) else y = 1e3 * r.record.timings_s[ctx.time] end
       if type(y) == "number" then pts[#pts + 1] = { x_value(axis, r), y } end
     end
-    series[#series + 1] = { title = s.label, points = pts, style = "linespoints" }
+    if #pts > 0 then series[#series + 1] = { title = s.label, points = pts, style = "linespoints" } end
   end
   if #series == 0 then return nil end
   local lo, hi = math.huge, -math.huge
@@ -230,7 +231,7 @@ local function along_axis(ctx, axis, scene_rows, name, what)
   return plot.draw(ctx.dir, (what == "error" and "error-vs-" or "cost-vs-") .. slug(axis.name) .. "-" .. name, {
     title = (what == "error" and ctx.err_label or time_fields[ctx.time]) .. " against " .. axis.name,
     rows = scene_rows, xlabel = axis.name .. (logx and " (log scale)" or ""), ylabel = ylabel,
-    logx = logx, series = series, hline = noise, noise = ctx.noise,
+    logx = logx, series = series, hline = noise, noise = what == "error" and ctx.noise or nil,
     subtitle = noise and "dashed: reference " .. ctx.noise.label or nil,
   })
 end
