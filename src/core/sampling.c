@@ -52,12 +52,7 @@ int sampling_batches(SamplingPattern p, int count)
     return 1;
 }
 
-/* First index of batch b of m over `count` samples. */
-static int batch_first(int b, int m, int count) { return (int)((long long)b * count / m); }
-
-static int batch_of(int i, int m, int count) { return (int)(((long long)(i + 1) * m - 1) / count); }
-
-int sampling_batch_of(SamplingPattern p, int i, int count) { return batch_of(i, sampling_batches(p, count), count); }
+int sampling_batch_of(SamplingPattern p, int i, int count) { return i % sampling_batches(p, count); }
 
 uint32_t sampling_stream(uint32_t seed, uint32_t id) { return hash_u32(id ^ hash_u32(seed + 0x9e3779b9u)); }
 
@@ -68,28 +63,26 @@ static float frac(double x) { return (float)(x - floor(x)); }
 
 void sample_2d(SamplingPattern p, uint32_t stream, int i, int count, float *u, float *v)
 {
-    int m = sampling_batches(p, count), b = batch_of(i, m, count), first = batch_first(b, m, count);
-    int j = i - first, n = batch_first(b + 1, m, count) - first; /* index and size within the batch */
-    uint32_t bs = b == 0 ? stream : hash_u32(stream ^ (0x85ebca6bu * (uint32_t)b)); /* the batch's own stream */
-    uint32_t hu = hash_u32(stream ^ (2u * (uint32_t)i)), hv = hash_u32(stream ^ (2u * (uint32_t)i + 1u) ^ 0x68e31da4u);
     switch (p) {
     case SAMPLING_R2: {
         const double a1 = 0.7548776662466927, a2 = 0.5698402909980532; /* 1/phi2, 1/phi2^2 */
-        double su = unit_float(hash_u32(bs)), sv = unit_float(hash_u32(bs ^ 0x5bd1e995u)); /* the batch's shift */
+        uint32_t m = (uint32_t)sampling_batches(p, count), b = (uint32_t)i % m, j = (uint32_t)i / m;
+        uint32_t bs = stream ^ (0x85ebca6bu * b); /* the batch's own shift */
+        double su = unit_float(hash_u32(bs)), sv = unit_float(hash_u32(bs ^ 0x5bd1e995u));
         *u = frac(su + a1 * (double)j);
         *v = frac(sv + a2 * (double)j);
         break;
     }
     case SAMPLING_STRATIFIED: {
-        int side = isqrt(n); /* the batch's own jittered side x side grid */
-        int cx = j % side, cy = j / side;
-        *u = ((float)cx + unit_float(hu)) / (float)side;
-        *v = ((float)cy + unit_float(hv)) / (float)side;
+        int m = sampling_batches(p, count), j = i / m; /* index within batch i % m */
+        int side = isqrt(count / m); /* the batch's own jittered side x side grid */
+        *u = ((float)(j % side) + unit_float(hash_u32(stream ^ (2u * (uint32_t)i)))) / (float)side;
+        *v = ((float)(j / side) + unit_float(hash_u32(stream ^ (2u * (uint32_t)i + 1u) ^ 0x68e31da4u))) / (float)side;
         break;
     }
     case SAMPLING_RANDOM:
-        *u = unit_float(hu);
-        *v = unit_float(hv);
+        *u = unit_float(hash_u32(stream ^ (2u * (uint32_t)i)));
+        *v = unit_float(hash_u32(stream ^ (2u * (uint32_t)i + 1u) ^ 0x68e31da4u));
         break;
     }
     /* (float)(x + frac) can round up to 1.0: keep the half-open interval. */

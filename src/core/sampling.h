@@ -22,8 +22,9 @@ bool sampling_check_count(SamplingPattern p, int count, Error *err);
 
 /* Randomised QMC (Owen 1997; L'Ecuyer & Lemieux 2002, "Recent advances in
  * randomized quasi-Monte Carlo methods" §2): an R2 or stratified stream of
- * `count` samples is cut into sampling_batches() consecutive batches, each an
- * independent randomisation of the pattern on its own (an R2 set with its own
+ * `count` samples is dealt into M = sampling_batches() interleaved batches
+ * (sample i is sample i / M of batch i % M), each an independent
+ * randomisation of the pattern on its own (an R2 set with its own
  * Cranley-Patterson shift, a jittered grid with its own jitter), so the
  * batch means are independent and their spread measures the estimate's
  * error. Random streams are one batch (independent samples need none). */
@@ -32,8 +33,7 @@ bool sampling_check_count(SamplingPattern p, int count, Error *err);
  * min(16, count) (sizes differ by at most one); stratified the largest of
  * 16, 9, 4 that leaves each batch a square grid, else 1. */
 int sampling_batches(SamplingPattern p, int count);
-/* The batch sample i of `count` belongs to: batch b holds indices
- * [b count / M, (b + 1) count / M), M = sampling_batches(p, count). */
+/* The batch sample i of `count` belongs to: i % sampling_batches(p, count). */
 int sampling_batch_of(SamplingPattern p, int i, int count);
 
 /* Seed of the stream of one pixel (or any other id). */

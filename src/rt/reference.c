@@ -99,26 +99,29 @@ static void add_sample(Accum *a, int batch, const float *w, const double *x, int
     a->n++;
 }
 
-/* Visibility of the `nc` channels the reference stores; samples first ..
- * first + 15 of `count`. */
-static void accumulate_visibility(Accum *a, const Batch *b, SamplingPattern pat, int first, int count, int nc)
+/* Batch of the sample after one of batch `batch`: core/sampling deals samples
+ * i into batches i % m, so consecutive lanes take consecutive batches. */
+static int next_batch(int batch, int m) { return batch + 1 == m ? 0 : batch + 1; }
+
+/* Visibility of the `nc` channels the reference stores; the packet's lane 0
+ * is in batch `batch` of m. */
+static void accumulate_visibility(Accum *a, const Batch *b, int batch, int m, int nc)
 {
-    for (int k = 0; k < PACKET; k++) {
+    for (int k = 0; k < PACKET; k++, batch = next_batch(batch, m)) {
         if (!b->valid[k]) continue;
         const LightSample *s = &b->ls[k];
         double vis = b->ray.tfar[k] == -INFINITY ? 0.0 : 1.0; /* Embree marks occluded rays with tfar = -inf */
         const float w[3] = {s->vis_weight.x, s->vis_weight.y, s->vis_weight.z};
         const double x[3] = {vis, vis, vis};
-        add_sample(a, sampling_batch_of(pat, first + k, count), w, x, nc);
+        add_sample(a, batch, w, x, nc);
     }
 }
 
 /* Lambertian direct illumination, course Eq. 1.3: E cos / pi per sample. */
-static void accumulate_irradiance(Accum *a, const Batch *b, SamplingPattern pat, int first, int count,
-                                  vec3 n_shading, vec3 albedo)
+static void accumulate_irradiance(Accum *a, const Batch *b, int batch, int m, vec3 n_shading, vec3 albedo)
 {
     static const float unit[3] = {1.0f, 1.0f, 1.0f};
-    for (int k = 0; k < PACKET; k++) {
+    for (int k = 0; k < PACKET; k++, batch = next_batch(batch, m)) {
         if (!b->valid[k]) continue;
         const LightSample *s = &b->ls[k];
         float vis = b->ray.tfar[k] == -INFINITY ? 0.0f : 1.0f;
@@ -126,7 +129,7 @@ static void accumulate_irradiance(Accum *a, const Batch *b, SamplingPattern pat,
         const float e[3] = {s->irradiance.x * albedo.x, s->irradiance.y * albedo.y, s->irradiance.z * albedo.z};
         double x[3];
         for (int c = 0; c < 3; c++) x[c] = e[c] * cos_p * vis * INV_PI;
-        add_sample(a, sampling_batch_of(pat, first + k, count), unit, x, 3);
+        add_sample(a, batch, unit, x, 3);
     }
 }
 
@@ -208,10 +211,11 @@ static void trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx
     for (int first = 0; first < j->count; first += PACKET) {
         fill_batch(b, j->light, org, p, stream, first, j->count, j->p);
         rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
+        int batch = sampling_batch_of(j->p->pattern, first, j->count), m = j->out->batches;
         if (j->p->measure == MEASURE_IRRADIANCE)
-            accumulate_irradiance(&a, b, j->p->pattern, first, j->count, j->vs->n_shading_world[s],
+            accumulate_irradiance(&a, b, batch, m, j->vs->n_shading_world[s],
                                   j->scene->objects[j->vs->object[s]].albedo);
-        else accumulate_visibility(&a, b, j->p->pattern, first, j->count, nc);
+        else accumulate_visibility(&a, b, batch, m, nc);
     }
     finish(&a, j->out, nc, j->out->value.data + (size_t)s * nc, j->out->std_error.data + (size_t)s * nc);
 }
