@@ -20,8 +20,8 @@ bool sampling_pattern_parse(const char *name, SamplingPattern *p, Error *err);
 /* Is `count` valid for the pattern (stratified needs a square)? */
 bool sampling_check_count(SamplingPattern p, int count, Error *err);
 
-/* Randomised QMC (Owen 1997; L'Ecuyer & Lemieux 2002, "Recent advances in
- * randomized quasi-Monte Carlo methods" §2): an R2 or stratified stream of
+/* Randomised QMC (L'Ecuyer & Lemieux 2002, "Recent advances in
+ * randomized quasi-Monte Carlo methods"): an R2 or stratified stream of
  * `count` samples is dealt into M = sampling_batches() interleaved batches
  * (sample i is sample i / M of batch i % M), each an independent
  * randomisation of the pattern on its own (an R2 set with its own

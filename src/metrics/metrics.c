@@ -59,7 +59,6 @@ static Region region_of(const float *ref, int nc)
     return v <= 0.01 ? REGION_UMBRA : v >= 0.99 ? REGION_LIT : REGION_PENUMBRA;
 }
 
-
 bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls, Metrics *m, Image *signed_error,
                      Error *err)
 {

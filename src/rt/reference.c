@@ -134,10 +134,12 @@ static void accumulate_irradiance(Accum *a, const Batch *b, int batch, int m, ve
 }
 
 /* Standard error of the ratio estimate mean = X / W from m independent
- * batches (Cochran 1977, Sampling Techniques, Eq. 6.13 over clusters; with
- * equal weights the batch means' standard deviation over sqrt(m), L'Ecuyer &
- * Lemieux 2002 §2): se^2 = m / (m - 1) sum_b (X_b - W_b mean)^2 / W^2. It is
- * 0 where every batch agrees: no smoothing floor. W > 0, m > 1. */
+ * batches, the linearised variance of a ratio estimator over independent
+ * clusters (Cochran, Sampling Techniques, ch. 6): se^2 = m / (m - 1)
+ * sum_b (X_b - W_b mean)^2 / W^2; with equal weights the batch means'
+ * standard deviation over sqrt(m), randomised QMC's error estimate (L'Ecuyer
+ * & Lemieux 2002). It is 0 where every batch agrees: no smoothing floor.
+ * W > 0, m > 1. */
 static double batch_spread(const Accum *a, int c, int m, double mean, double w)
 {
     double sq = 0;
