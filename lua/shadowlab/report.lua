@@ -278,7 +278,7 @@ function report.write(result, opts)
   local index = result.out .. "/index.html"
   html.write_index(index, { result = result, rows = result.rows, ok_rows = rows, plots = plots, opts = opts,
                             err_label = ctx.err_label, time_label = time_fields[ctx.time], time = ctx.time,
-                            err = ctx.err })
+                            err = ctx.err, noise = ctx.noise })
   io.stderr:write("report: " .. index .. "\n")
   return index
 end
