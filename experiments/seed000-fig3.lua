@@ -106,7 +106,7 @@ for _, s in ipairs(scenes) do
     md[#md + 1] = string.format("| %s | %.4f | %.4f | %.4f | %.1f | %.1f |", r.label, m.all.rmse, m.penumbra.rmse,
                                 e64, 1e3 * t.evaluate_min, 1e3 * t.frame)
     csv[#csv + 1] = string.format("%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g", s, r.label, m.all.rmse, m.penumbra.rmse,
-                                  e64, r64 and r64.record.metrics.noise_rms or 0 / 0, 1e3 * t.evaluate_min,
+                                  e64, r64 and r64.record.metrics.all.noise_rms or 0 / 0, 1e3 * t.evaluate_min,
                                   1e3 * t.frame)
     for plane, label in pairs(PCSS_BASELINE) do
       if r.label == label then base[plane] = { r = r, e64 = e64 } end

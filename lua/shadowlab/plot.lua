@@ -2,7 +2,8 @@
 -- per series), the script (NAME.gp, kept so a figure can be restyled and
 -- redrawn by hand), and the two images. Series styles: "points",
 -- "linespoints", "lines" (analytic curves), "front" (a Pareto staircase,
--- black); `hline` draws a dashed horizontal line (the reference's noise);
+-- black); `hline` draws a dashed horizontal line (the reference's noise,
+-- `noise` = {label, value(record)} naming it in the subtitle);
 -- `logx`, `logy` log scales. The subtitle's first part (scene, resolution,
 -- reference samples and noise) is built from the records plotted; the
 -- images are written under temporary names and renamed when gnuplot is done.
@@ -44,17 +45,28 @@ local function plot_clause(data, i, s)
   return string.format("%s index %d using 1:2 %s title %s", quoted(data), i - 1, style, quoted(s.title))
 end
 
+-- The range of the numbers among values (json.null, an empty region's
+-- statistic, is left out; "none" when no number is left).
 local function range_text(values, fmt)
   local lo, hi = math.huge, -math.huge
-  for _, v in ipairs(values) do lo, hi = math.min(lo, v), math.max(hi, v) end
+  for _, v in ipairs(values) do
+    if type(v) == "number" then lo, hi = math.min(lo, v), math.max(hi, v) end
+  end
+  if lo > hi then return "none" end
   if lo == hi then return string.format(fmt, lo) end
   return string.format(fmt .. "-" .. fmt, lo, hi)
 end
 
+-- The reference noise a plot of the whole image's RMSE states.
+plot.all_noise = { label = "noise rms", value = function(rec) return rec.metrics.all.noise_rms end }
+
 -- "bunny 320x240, reference 256 samples, noise rms 0.0041" for the records
 -- (experiment rows or run:record() tables), one part per scene and
 -- resolution (sep between them, "; " by default), ranges where they differ.
-function plot.caption(rows, sep)
+-- noise ({label, value(record)}, plot.all_noise by default) names the
+-- noise of the region and statistic plotted.
+function plot.caption(rows, sep, noise)
+  noise = noise or plot.all_noise
   local groups, order = {}, {}
   for _, r in ipairs(rows) do
     local rec = r.record or r
@@ -63,14 +75,17 @@ function plot.caption(rows, sep)
       groups[id] = { samples = {}, noise = {} }
       order[#order + 1] = id
     end
-    table.insert(groups[id].samples, rec.reference.samples)
-    table.insert(groups[id].noise, rec.metrics.noise_rms)
+    -- a delta light's reference traces one exact ray whatever the samples asked
+    if rec.reference.std_error == "exact" then groups[id].exact = true
+    else table.insert(groups[id].samples, rec.reference.samples) end
+    table.insert(groups[id].noise, noise.value(rec))
   end
   local parts = {}
   for i, id in ipairs(order) do
     local g = groups[id]
-    parts[i] = string.format("%s, reference %s samples, noise rms %s", id, range_text(g.samples, "%d"),
-                             range_text(g.noise, "%.4f"))
+    local samples = #g.samples > 0 and range_text(g.samples, "%d") .. " samples" or nil
+    if g.exact then samples = (samples and samples .. " and " or "") .. "one exact ray (delta light)" end
+    parts[i] = string.format("%s, reference %s, %s %s", id, samples, noise.label, range_text(g.noise, "%.4f"))
   end
   return table.concat(parts, sep or "; ")
 end
@@ -82,7 +97,7 @@ end
 -- closed-form curves say what they are (spec.analytic). Nothing else is
 -- accepted, so no plot can leave it out.
 local function provenance(name, spec)
-  if spec.rows and #spec.rows > 0 then return plot.caption(spec.rows, "\n") end
+  if spec.rows and #spec.rows > 0 then return plot.caption(spec.rows, "\n", spec.noise) end
   if spec.scene and spec.no_reference then
     return string.format("%s %dx%d, no reference: %s", spec.scene.name, spec.scene.width, spec.scene.height,
                          spec.no_reference)

@@ -24,15 +24,47 @@ local field_names = { rmse = "RMSE", mae = "MAE", max_abs = "max |error|", mean_
                       leak_mean = "mean light leak", dark_mean = "mean over-darkening",
                       misclassified = "fraction |error| > 0.5" }
 
--- The error metric: a path into the record's metrics, "all.rmse" by default.
+-- The reference noise a statistic of a region is compared with: its rms for
+-- RMSE, sqrt(2/pi) times its mean for MAE (the mean |e| of Gaussian noise);
+-- nil for statistics without a noise model (max, signed, leak, dark, >0.5).
+local function noise_of(region, field)
+  local function number(v) return type(v) == "number" and v or nil end
+  if field == "rmse" or field == "rmse_debiased" then
+    return { label = "noise rms" .. (region == "all" and "" or " (" .. region .. ")"),
+             value = function(rec) return number(rec.metrics[region] and rec.metrics[region].noise_rms) end }
+  elseif field == "mae" then
+    return { label = "noise MAE" .. (region == "all" and "" or " (" .. region .. ")"),
+             value = function(rec)
+               local v = number(rec.metrics[region] and rec.metrics[region].noise_mean)
+               return v and math.sqrt(2 / math.pi) * v
+             end }
+  end
+  return nil
+end
+
+-- The error metric: a path into the record's metrics, "all.rmse" by default;
+-- the getter returns nil for an empty region (json.null), so it is not plotted.
 local function metric_getter(path)
   local region, field = path:match("^(%w+)%.([%w_]+)$")
   if not region then region, field = "all", path end
   local label = (field_names[field] or field) .. (region == "all" and "" or " (" .. region .. ")")
   return function(r)
     local m = r.record.metrics[region]
-    return m and m[field]
-  end, label
+    local v = m and m[field]
+    return type(v) == "number" and v or nil
+  end, label, noise_of(region, field)
+end
+
+-- The dashed line of a plot of rows: the largest noise among them of the
+-- region and statistic plotted (nil when it has none).
+local function noise_line(ctx, rows)
+  if not ctx.noise then return nil end
+  local top
+  for _, r in ipairs(rows) do
+    local v = ctx.noise.value(r.record)
+    if v and (not top or v > top) then top = v end
+  end
+  return top
 end
 
 local time_fields = { frame = "frame time", evaluate_median = "median evaluation", evaluate_min = "minimum evaluation" }
@@ -168,10 +200,10 @@ local function error_vs_time(ctx, variant_rows, name)
   local fpts = {}
   for _, p in ipairs(front) do fpts[#fpts + 1] = { p.x, p.y } end
   series[#series + 1] = { title = "Pareto front", points = fpts, style = "front" }
-  local noise = variant_rows[1].record.metrics.noise_rms
+  local noise = noise_line(ctx, variant_rows)
   return plot.draw(ctx.dir, "error-vs-time-" .. name, {
     title = ctx.err_label .. " against " .. time_fields[ctx.time],
-    rows = variant_rows, subtitle = "dashed: reference noise",
+    rows = variant_rows, subtitle = noise and "dashed: reference " .. ctx.noise.label or nil, noise = ctx.noise,
     xlabel = time_fields[ctx.time] .. " (ms, log scale)", ylabel = ctx.err_label, logx = true,
     series = series, hline = noise,
   })
@@ -182,10 +214,11 @@ local function along_axis(ctx, axis, scene_rows, name, what)
   for _, s in ipairs(series_along(axis, scene_rows)) do
     local pts = {}
     for _, r in ipairs(s.rows) do
-      local y = what == "error" and ctx.err(r) or 1e3 * r.record.timings_s[ctx.time]
+      local y -- nil for an empty region: the point is left out
+      if what == "error" then y = ctx.err(r) else y = 1e3 * r.record.timings_s[ctx.time] end
       if type(y) == "number" then pts[#pts + 1] = { x_value(axis, r), y } end
     end
-    series[#series + 1] = { title = s.label, points = pts, style = "linespoints" }
+    if #pts > 0 then series[#series + 1] = { title = s.label, points = pts, style = "linespoints" } end
   end
   if #series == 0 then return nil end
   local lo, hi = math.huge, -math.huge
@@ -194,10 +227,12 @@ local function along_axis(ctx, axis, scene_rows, name, what)
   end
   local logx = lo > 0 and hi / lo >= 8
   local ylabel = what == "error" and ctx.err_label or time_fields[ctx.time] .. " (ms)"
+  local noise = what == "error" and noise_line(ctx, scene_rows) or nil
   return plot.draw(ctx.dir, (what == "error" and "error-vs-" or "cost-vs-") .. slug(axis.name) .. "-" .. name, {
     title = (what == "error" and ctx.err_label or time_fields[ctx.time]) .. " against " .. axis.name,
     rows = scene_rows, xlabel = axis.name .. (logx and " (log scale)" or ""), ylabel = ylabel,
-    logx = logx, series = series,
+    logx = logx, series = series, hline = noise, noise = what == "error" and ctx.noise or nil,
+    subtitle = noise and "dashed: reference " .. ctx.noise.label or nil,
   })
 end
 
@@ -216,7 +251,7 @@ function report.write(result, opts)
   end
   local ctx = { dir = result.out .. "/plots", time = opts.time or "frame" }
   if not time_fields[ctx.time] then error("report: time must be frame, evaluate_median or evaluate_min", 2) end
-  ctx.err, ctx.err_label = metric_getter(opts.error or "all.rmse")
+  ctx.err, ctx.err_label, ctx.noise = metric_getter(opts.error or "all.rmse")
   local rows = ok_rows(result.rows)
   local axes = swept_names(rows)
   mark_swept(rows, axes)
@@ -243,7 +278,7 @@ function report.write(result, opts)
   local index = result.out .. "/index.html"
   html.write_index(index, { result = result, rows = result.rows, ok_rows = rows, plots = plots, opts = opts,
                             err_label = ctx.err_label, time_label = time_fields[ctx.time], time = ctx.time,
-                            err = ctx.err })
+                            err = ctx.err, noise = ctx.noise })
   io.stderr:write("report: " .. index .. "\n")
   return index
 end

@@ -9,7 +9,7 @@
 #include "core/error.h"
 
 typedef enum SamplingPattern {
-    SAMPLING_R2,         /* Roberts' R2 low-discrepancy sequence, Cranley-Patterson rotated per stream */
+    SAMPLING_R2,         /* Roberts' R2 low-discrepancy sequence, Cranley-Patterson rotated per batch */
     SAMPLING_STRATIFIED, /* jittered m x m grid; the count must be a square */
     SAMPLING_RANDOM,     /* independent uniform samples (hash-based) */
 } SamplingPattern;
@@ -19,6 +19,22 @@ const char *sampling_pattern_name(SamplingPattern p);
 bool sampling_pattern_parse(const char *name, SamplingPattern *p, Error *err);
 /* Is `count` valid for the pattern (stratified needs a square)? */
 bool sampling_check_count(SamplingPattern p, int count, Error *err);
+
+/* Randomised QMC (L'Ecuyer & Lemieux 2002, "Recent advances in
+ * randomized quasi-Monte Carlo methods"): an R2 or stratified stream of
+ * `count` samples is dealt into M = sampling_batches() interleaved batches
+ * (sample i is sample i / M of batch i % M), each an independent
+ * randomisation of the pattern on its own (an R2 set with its own
+ * Cranley-Patterson shift, a jittered grid with its own jitter), so the
+ * batch means are independent and their spread measures the estimate's
+ * error. Random streams are one batch (independent samples need none). */
+#define SAMPLING_MAX_BATCHES 16
+/* Batches of a stream of `count`: 1 for random and for count 1; R2
+ * min(16, count) (sizes differ by at most one); stratified the largest of
+ * 16, 9, 4 that leaves each batch a square grid, else 1. */
+int sampling_batches(SamplingPattern p, int count);
+/* The batch sample i of `count` belongs to: i % sampling_batches(p, count). */
+int sampling_batch_of(SamplingPattern p, int i, int count);
 
 /* Seed of the stream of one pixel (or any other id). */
 uint32_t sampling_stream(uint32_t seed, uint32_t id);

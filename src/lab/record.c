@@ -82,7 +82,10 @@ static void write_reference(JsonWriter *w, const RunReport *r)
     json_object_begin(w, "reference");
     json_string(w, "measure", measure_name(p->measure));
     json_int(w, "samples", p->samples);
+    json_int(w, "rays_per_sample", r->ref->rays_per_sample);
     json_string(w, "pattern", sampling_pattern_name(p->pattern));
+    json_string(w, "std_error", ref_error_estimator_name(r->ref->estimator));
+    json_int(w, "batches", r->ref->batches);
     json_int(w, "seed", p->seed);
     json_int(w, "rays", r->ref->rays);
     hash_hex(r->ref_info->key, hex);
@@ -92,7 +95,6 @@ static void write_reference(JsonWriter *w, const RunReport *r)
     if (r->ref_info->cache_note[0]) json_string(w, "cache_note", r->ref_info->cache_note);
     json_number(w, "seconds", r->ref_info->seconds);
     json_number(w, "rays_per_second", r->ref_info->rays_per_second);
-    if (r->metrics) json_number(w, "noise_rms", r->metrics->noise_rms);
     json_object_end(w);
 }
 
@@ -100,13 +102,18 @@ static void write_stats(JsonWriter *w, const char *key, const ErrorStats *s)
 {
     json_object_begin(w, key);
     json_int(w, "count", s->count);
-    json_number(w, "mae", s->mae);
+    json_int(w, "nonfinite", s->nonfinite);
+    json_number(w, "mae", s->mae); /* null when the region is empty */
     json_number(w, "rmse", s->rmse);
     json_number(w, "max_abs", s->max_abs);
     json_number(w, "mean_signed", s->mean_signed);
     json_number(w, "leak_mean", s->leak_mean);
     json_number(w, "dark_mean", s->dark_mean);
     json_number(w, "misclassified", s->misclassified);
+    json_number(w, "noise_rms", s->noise_rms);
+    json_number(w, "noise_mean", s->noise_mean);
+    json_number(w, "rmse_debiased", s->rmse_debiased);
+    if (s->count > 0) json_bool(w, "resolved", s->resolved); /* absent, like the statistics, for an empty region */
     json_object_end(w);
 }
 
@@ -120,9 +127,6 @@ static void write_metrics(JsonWriter *w, const RunReport *r)
     for (int g = 0; g < REGION_COUNT; g++) write_stats(w, region_name((Region)g), &m->region[g]);
     json_int(w, "false_shadow", m->false_shadow);
     json_int(w, "false_lit", m->false_lit);
-    json_number(w, "noise_rms", m->noise_rms);
-    json_number(w, "rmse_debiased", m->rmse_debiased);
-    json_bool(w, "resolved", m->resolved);
     json_int(w, "nonfinite", m->nonfinite);
     json_int(w, "out_of_range", m->out_of_range);
     json_number(w, "error_png_scale", r->error_scale);
@@ -270,30 +274,63 @@ void report_print(const RunReport *r, FILE *fp)
     report_print_body(r, fp);
 }
 
+/* "reference: visibility, 1024 r2 samples in 16 randomisations, std error
+ * their spread, ..." : what was traced and how its noise was estimated. */
+static void print_reference(const RunReport *r, FILE *fp)
+{
+    const Reference *ref = r->ref;
+    fprintf(fp, "reference: %s, ", measure_name(ref->params.measure));
+    if (ref->estimator == REF_ERROR_EXACT) fprintf(fp, "one ray per sample (delta light: exact, std error 0)");
+    else if (ref->estimator == REF_ERROR_RQMC)
+        fprintf(fp, "%d %s samples in %d randomisations (std error: their spread)", ref->params.samples,
+                sampling_pattern_name(ref->params.pattern), ref->batches);
+    else
+        fprintf(fp, "%d %s samples (std error: independent samples')", ref->params.samples,
+                sampling_pattern_name(ref->params.pattern));
+    fprintf(fp, ", %.3g s (%s), %.3g Mrays/s\n", r->ref_info->seconds, ref_origin_name(r->ref_info->origin),
+            r->ref_info->rays_per_second * 1e-6);
+}
+
+/* A statistic, or "-" for an empty region's NaN. */
+static void print_cell(FILE *fp, const char *fmt, int width, double v)
+{
+    if (isnan(v)) fprintf(fp, " %*s", width, "-");
+    else fprintf(fp, fmt, v);
+}
+
+/* One row per region: errors, then the reference's noise over the same samples and the RMSE net of it. */
+static void print_metrics(const Metrics *m, FILE *fp)
+{
+    fprintf(fp, "%-9s %9s %9s %9s %9s %9s %9s %9s %7s %9s %9s %s\n", "region", "samples", "MAE", "RMSE", "max|e|",
+            "signed", "leak", "dark", ">0.5", "noise", "RMSE-net", "non-finite");
+    for (int g = 0; g < REGION_COUNT; g++) {
+        const ErrorStats *s = &m->region[g];
+        fprintf(fp, "%-9s %9ld", region_name((Region)g), s->count);
+        print_cell(fp, " %9.5f", 9, s->mae);
+        print_cell(fp, " %9.5f", 9, s->rmse);
+        print_cell(fp, " %9.5f", 9, s->max_abs);
+        print_cell(fp, " %+9.5f", 9, s->mean_signed);
+        print_cell(fp, " %9.5f", 9, s->leak_mean);
+        print_cell(fp, " %9.5f", 9, s->dark_mean);
+        print_cell(fp, " %7.4f", 7, s->misclassified);
+        print_cell(fp, " %9.5f", 9, s->noise_rms);
+        print_cell(fp, " %9.5f", 9, s->rmse_debiased);
+        fprintf(fp, " %ld%s\n", s->nonfinite, s->count > 0 && !s->resolved ? "  (below 2x the noise: not resolved)" : "");
+    }
+    fprintf(fp, "false shadow (acne) %ld, false lit (leaks) %ld, non-finite %ld (left out), outside [0,1] %ld\n",
+            m->false_shadow, m->false_lit, m->nonfinite, m->out_of_range);
+}
+
 void report_print_body(const RunReport *r, FILE *fp)
 {
-    if (r->ref)
-        fprintf(fp, "reference: %s, %d %s samples, %.3g s (%s), %.3g Mrays/s\n", measure_name(r->ref->params.measure),
-                r->ref->params.samples, sampling_pattern_name(r->ref->params.pattern), r->ref_info->seconds,
-                ref_origin_name(r->ref_info->origin), r->ref_info->rays_per_second * 1e-6);
+    if (r->ref) print_reference(r, fp);
     if (r->render)
         fprintf(fp, "technique: prepare %.3g s, evaluate %.3g s (median of %d, min %.3g s)\n", r->render->prepare_s,
                 r->render->eval_median_s, r->render->repeat, r->render->eval_min_s);
     if (r->metrics) {
-        const Metrics *m = r->metrics;
-        fprintf(fp, "%-9s %9s %9s %9s %9s %9s %9s %9s %7s\n", "region", "samples", "MAE", "RMSE", "max|e|", "signed",
-                "leak", "dark", ">0.5");
-        for (int g = 0; g < REGION_COUNT; g++) {
-            const ErrorStats *s = &m->region[g];
-            fprintf(fp, "%-9s %9ld %9.5f %9.5f %9.5f %+9.5f %9.5f %9.5f %7.4f\n", region_name((Region)g), s->count,
-                    s->mae, s->rmse, s->max_abs, s->mean_signed, s->leak_mean, s->dark_mean, s->misclassified);
-        }
-        fprintf(fp, "reference noise rms %.5f; RMSE net of noise %.5f%s\n", m->noise_rms, m->rmse_debiased,
-                m->resolved ? "" : "  (below 2x the reference's noise: not resolved)");
-        fprintf(fp, "false shadow (acne) %ld, false lit (leaks) %ld, non-finite %ld, outside [0,1] %ld\n",
-                m->false_shadow, m->false_lit, m->nonfinite, m->out_of_range);
-        fprintf(fp, "error PNG scale: blue -%g (too dark) .. white 0 .. red +%g (leaking)\n", r->error_scale,
-                r->error_scale);
+        print_metrics(r->metrics, fp);
+        fprintf(fp, "error PNG scale: blue -%g (too dark) .. white 0 .. red +%g (leaking), black non-finite\n",
+                r->error_scale, r->error_scale);
     }
     const ResourceManager *rm = lab_resources(r->lab);
     for (int i = 0; i < rm_log_count(rm); i++) {

@@ -15,6 +15,7 @@ const char *report_stem(const RunReport *r) { return r->tech ? r->tech->name : "
 double report_error_scale(double max_abs)
 {
     static const double steps[] = {1, 2, 5};
+    if (isnan(max_abs)) return 1.0; /* no finite error (an empty region): the full range */
     for (double decade = 0.01; decade < 1e6; decade *= 10)
         for (int i = 0; i < 3; i++)
             if (steps[i] * decade >= max_abs) return steps[i] * decade;
@@ -193,7 +194,8 @@ static void shade(const RunReport *r, const ViewSamples *vs, const Image *vis, I
 }
 
 /* Diverging map: blue (-scale, over-darkening), white (0), red (+scale, light
- * leaking); samples outside the evaluated class are grey. */
+ * leaking); samples outside the evaluated class are grey, non-finite
+ * estimates black. */
 static void error_colors(const Image *err_img, const uint8_t *cls, double scale, Image *out)
 {
     for (int s = 0; s < out->width * out->height; s++) {
@@ -201,6 +203,7 @@ static void error_colors(const Image *err_img, const uint8_t *cls, double scale,
         if (cls[s] != SAMPLE_LIT_CANDIDATE) { o[0] = o[1] = o[2] = 0.5f; continue; }
         double e = 0;
         for (int c = 0; c < err_img->channels; c++) e += err_img->data[(size_t)s * err_img->channels + c];
+        if (!isfinite(e)) { o[0] = o[1] = o[2] = 0.0f; continue; }
         float t = (float)fmax(-1.0, fmin(1.0, e / err_img->channels / scale));
         o[0] = t < 0 ? 1.0f + t : 1.0f;
         o[1] = 1.0f - fabsf(t);

@@ -305,7 +305,7 @@ static bool measure(const StabJob *j, Lab *lab, const Image *v, const uint8_t *c
     StabMeasure m;
     if (!metrics_compute(v, ref, cls, term, &m.all, NULL, &e)) return fail(r, "metrics failed: %s", e.msg);
     r->ref_samples = light_is_delta(&lab_scene(lab)->lights[0]) ? 1 : rq.params.samples;
-    r->noise_rms = m.all.noise_rms;
+    r->noise_rms = m.all.region[REGION_ALL].noise_rms;
     if (m.all.region[REGION_ALL].count > 0) {
         r->mae = m.all.region[REGION_ALL].mae;
         r->rmse = m.all.region[REGION_ALL].rmse;

@@ -10,9 +10,10 @@ const char *region_name(Region r)
     return names[r];
 }
 
-typedef struct Sums { long n; double abs, sq, max_abs, signed_sum, leak, dark; long miscl; } Sums;
+typedef struct Sums { long n, nonfinite; double abs, sq, max_abs, signed_sum, leak, dark, noise_sq, noise; long miscl; } Sums;
 
-static void add(Sums *s, double e)
+/* One finite error e against a reference with standard error sd. */
+static void add(Sums *s, double e, double sd)
 {
     double a = fabs(e);
     s->n++;
@@ -23,14 +24,19 @@ static void add(Sums *s, double e)
     s->leak += fmax(e, 0.0);
     s->dark += fmax(-e, 0.0);
     s->miscl += a > 0.5;
+    s->noise_sq += sd * sd;
+    s->noise += sd;
 }
 
 static ErrorStats finish(const Sums *s, int channels)
 {
-    ErrorStats st = {0};
+    ErrorStats st = {.count = s->n / channels, .nonfinite = s->nonfinite};
     long n = s->n; /* sample-channel pairs */
-    st.count = n / channels;
-    if (n == 0) return st;
+    if (n == 0) { /* absent, not perfect */
+        st.mae = st.rmse = st.max_abs = st.mean_signed = st.leak_mean = st.dark_mean = st.misclassified = NAN;
+        st.noise_rms = st.noise_mean = st.rmse_debiased = NAN;
+        return st;
+    }
     st.mae = s->abs / (double)n;
     st.rmse = sqrt(s->sq / (double)n);
     st.max_abs = s->max_abs;
@@ -38,6 +44,10 @@ static ErrorStats finish(const Sums *s, int channels)
     st.leak_mean = s->leak / (double)n;
     st.dark_mean = s->dark / (double)n;
     st.misclassified = (double)s->miscl / (double)n;
+    st.noise_rms = sqrt(s->noise_sq / (double)n);
+    st.noise_mean = s->noise / (double)n;
+    st.rmse_debiased = sqrt(fmax(0.0, st.rmse * st.rmse - st.noise_rms * st.noise_rms));
+    st.resolved = st.rmse > 2.0 * st.noise_rms;
     return st;
 }
 
@@ -52,17 +62,6 @@ static Region region_of(const float *ref, int nc, bool terminator)
     return v <= 0.01 ? REGION_UMBRA : v >= 0.99 ? REGION_LIT : REGION_PENUMBRA;
 }
 
-/* The error of one estimate value: non-finite counts as the worst case. */
-static double sample_error(float est, float ref, Metrics *m)
-{
-    if (!isfinite(est)) {
-        m->nonfinite++;
-        return 1.0;
-    }
-    if (est < 0.0f || est > 1.0f) m->out_of_range++;
-    return (double)est - (double)ref;
-}
-
 bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls, const uint8_t *terminator,
                      Metrics *m, Image *signed_error, Error *err)
 {
@@ -72,7 +71,6 @@ bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls,
                          est->channels, rv->width, rv->height, rv->channels);
     memset(m, 0, sizeof *m);
     Sums sums[REGION_COUNT] = {{0}};
-    double noise_sq = 0;
     int nc = rv->channels;
     long count = (long)rv->width * rv->height;
     for (long s = 0; s < count; s++) {
@@ -85,20 +83,21 @@ bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls,
         const float *r = rv->data + s * nc, *e = est->data + s * nc, *sd = ref->std_error.data + s * nc;
         Region reg = region_of(r, nc, terminator && terminator[s]);
         for (int c = 0; c < nc; c++) {
-            double err_c = sample_error(e[c], r[c], m);
-            add(&sums[REGION_ALL], err_c);
-            add(&sums[reg], err_c);
-            noise_sq += (double)sd[c] * sd[c];
-            m->false_shadow += r[c] > 0.5f && !(e[c] >= 0.5f);
-            m->false_lit += r[c] < 0.5f && e[c] > 0.5f;
+            double err_c = (double)e[c] - (double)r[c]; /* NaN or Inf for a non-finite estimate */
             if (se) se[c] = (float)err_c;
+            if (!isfinite(e[c])) { /* counted apart, never a value */
+                sums[REGION_ALL].nonfinite++;
+                sums[reg].nonfinite++;
+                continue;
+            }
+            add(&sums[REGION_ALL], err_c, sd[c]);
+            add(&sums[reg], err_c, sd[c]);
+            m->out_of_range += e[c] < 0.0f || e[c] > 1.0f;
+            m->false_shadow += r[c] > 0.5f && e[c] < 0.5f;
+            m->false_lit += r[c] < 0.5f && e[c] > 0.5f;
         }
     }
     for (int g = 0; g < REGION_COUNT; g++) m->region[g] = finish(&sums[g], nc);
-    long n = sums[REGION_ALL].n;
-    m->noise_rms = n ? sqrt(noise_sq / (double)n) : 0.0;
-    double rmse = m->region[REGION_ALL].rmse;
-    m->rmse_debiased = sqrt(fmax(0.0, rmse * rmse - m->noise_rms * m->noise_rms));
-    m->resolved = rmse > 2.0 * m->noise_rms;
+    m->nonfinite = m->region[REGION_ALL].nonfinite;
     return true;
 }

@@ -8,7 +8,10 @@
  * reference is the visibility of the light's part above the plane, see
  * scene/light.h) is scored in `terminator` instead, whatever its value; `all`
  * holds every lit candidate, terminator ones included. RGB images are scored
- * per channel, averaged (the max over channels for max_abs). */
+ * per channel, averaged (the max over channels for max_abs). Non-finite
+ * estimates are counted apart (nonfinite) and left out of every sum; a region
+ * with no finite estimate is absent: count 0 and NaN statistics (null in
+ * records). */
 #ifndef SL_METRICS_H
 #define SL_METRICS_H
 #include "rt/reference.h"
@@ -17,11 +20,16 @@ typedef enum Region { REGION_ALL, REGION_PENUMBRA, REGION_UMBRA, REGION_LIT, REG
 const char *region_name(Region r);
 
 typedef struct ErrorStats {
-    long count;            /* samples in the region */
+    long count;            /* samples in the region with finite estimates */
+    long nonfinite;        /* sample-channels in the region with NaN or Inf estimates, left out */
     double mae, rmse, max_abs, mean_signed;
     double leak_mean;      /* mean of max(e, 0): light leaking */
     double dark_mean;      /* mean of max(-e, 0): over-darkening; leak + dark = mae */
     double misclassified;  /* fraction with |e| > 0.5 (hard misclassification) */
+    double noise_rms;      /* sqrt(mean of the reference's squared standard errors) over the same samples */
+    double noise_mean;     /* mean of the reference's standard errors (the MAE's noise: sqrt(2/pi) times it) */
+    double rmse_debiased;  /* sqrt(max(0, rmse^2 - noise_rms^2)): RMSE net of reference noise */
+    bool resolved;         /* rmse > 2 noise_rms: the error is above the reference's noise */
 } ErrorStats;
 
 typedef struct Metrics {
@@ -29,10 +37,7 @@ typedef struct Metrics {
     ErrorStats region[REGION_COUNT];
     long false_shadow;     /* reference lit (> 0.5), estimate shadowed (< 0.5): acne */
     long false_lit;        /* reference shadowed (< 0.5), estimate lit (> 0.5): leaks, peter panning */
-    double noise_rms;      /* sqrt(mean of the reference's squared standard errors) */
-    double rmse_debiased;  /* sqrt(max(0, rmse^2 - noise_rms^2)): RMSE net of reference noise */
-    bool resolved;         /* rmse > 2 noise_rms: the error is above the reference's noise */
-    long nonfinite;        /* NaN or Inf estimates (counted as error 1) */
+    long nonfinite;        /* NaN or Inf estimates (sample-channels), left out of every statistic */
     long out_of_range;     /* estimates outside [0, 1] */
 } Metrics;
 

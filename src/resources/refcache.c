@@ -1,21 +1,23 @@
 /* refcache.c -- reference cache files. Layout (little-endian, native):
- *   "SLREF\0\0\1" | key u64 | width, height, channels, measure, samples,
- *   pattern i32 | seed u32 | rays i64 | value floats | std_error floats |
- *   FNV-1a 64 checksum of everything before it. */
+ *   "SLREF\0\0\2" | key u64 | width, height, channels, measure, samples,
+ *   pattern i32 | seed u32 | rays_per_sample, estimator, batches i32 | pad i32 |
+ *   rays i64 | value floats | std_error floats | FNV-1a 64 checksum of
+ *   everything before it. Version 2: std_error by randomised QMC batches
+ *   (version 1's smoothed binomial entries are read as corrupt and recomputed). */
 #include "resources/refcache.h"
 #include <stdlib.h>
 #include <string.h>
 #include "core/fsutil.h"
 #include "core/hash.h"
 
-static const char MAGIC[8] = {'S', 'L', 'R', 'E', 'F', 0, 0, 1};
+static const char MAGIC[8] = {'S', 'L', 'R', 'E', 'F', 0, 0, 2};
 
 typedef struct Header {
     char magic[8];
     uint64_t key;
     int32_t width, height, channels, measure, samples, pattern;
     uint32_t seed;
-    int32_t pad;
+    int32_t rays_per_sample, estimator, batches, pad;
     int64_t rays;
 } Header;
 
@@ -45,7 +47,9 @@ static bool header_sane(const Header *h, uint64_t key)
     return memcmp(h->magic, MAGIC, 8) == 0 && h->key == key && h->width > 0 && h->height > 0 &&
            h->width <= 65536 && h->height <= 65536 && (h->channels == 1 || h->channels == 3) &&
            h->measure >= 0 && h->measure <= MEASURE_IRRADIANCE && h->pattern >= 0 &&
-           h->pattern < SAMPLING_PATTERN_COUNT && h->samples > 0;
+           h->pattern < SAMPLING_PATTERN_COUNT && h->samples > 0 && h->rays_per_sample > 0 &&
+           h->rays_per_sample <= h->samples && h->estimator >= 0 && h->estimator < REF_ERROR_ESTIMATOR_COUNT &&
+           h->batches >= 1 && h->batches <= SAMPLING_MAX_BATCHES;
 }
 
 RefcacheStatus refcache_read(const char *path, uint64_t key, Reference *ref, Error *why)
@@ -79,6 +83,9 @@ RefcacheStatus refcache_read(const char *path, uint64_t key, Reference *ref, Err
     memcpy(ref->std_error.data, buf + sizeof h + n * sizeof(float), n * sizeof(float));
     ref->params = (ReferenceParams){(Measure)h.measure, h.samples, (SamplingPattern)h.pattern, h.seed};
     ref->rays = h.rays;
+    ref->rays_per_sample = h.rays_per_sample;
+    ref->estimator = (RefErrorEstimator)h.estimator;
+    ref->batches = h.batches;
     st = REFCACHE_HIT;
 done:
     free(buf);
@@ -96,7 +103,9 @@ bool refcache_write(const char *dir, const char *path, uint64_t key, const Refer
     if (!mkdir_p(dir, err)) return false;
     Header h = {.key = key, .width = ref->value.width, .height = ref->value.height, .channels = ref->value.channels,
                 .measure = (int32_t)ref->params.measure, .samples = ref->params.samples,
-                .pattern = (int32_t)ref->params.pattern, .seed = ref->params.seed, .rays = ref->rays};
+                .pattern = (int32_t)ref->params.pattern, .seed = ref->params.seed,
+                .rays_per_sample = ref->rays_per_sample, .estimator = (int32_t)ref->estimator,
+                .batches = ref->batches, .rays = ref->rays};
     memcpy(h.magic, MAGIC, 8);
     AtomicFile af;
     if (!atomic_open(&af, path, err)) return false;

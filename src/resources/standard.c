@@ -187,7 +187,7 @@ const PointTable *res_point_table(ResourceManager *rm, const char *generator, Po
 /* ---- references --------------------------------------------------------- */
 
 /* Bump when the reference's algorithm changes, so old cache entries miss. */
-#define REFERENCE_VERSION 2 /* 2: visibility over the part of the light above the horizon */
+#define REFERENCE_VERSION 3 /* 2: visibility over the part of the light above the horizon; 3: std_error by randomised QMC (rt/reference.c) */
 
 const char *ref_origin_name(RefOrigin o)
 {

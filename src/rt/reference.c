@@ -38,26 +38,38 @@ int reference_channels(const Scene *scene, int light_index, Measure m)
     return (m == MEASURE_IRRADIANCE || scene->lights[light_index].kind == LIGHT_TEXTURED_RECT) ? 3 : 1;
 }
 
-/* Running sums of one view sample's estimator, per colour channel. */
+const char *ref_error_estimator_name(RefErrorEstimator e)
+{
+    static const char *const names[REF_ERROR_ESTIMATOR_COUNT] = {"exact", "independent", "rqmc"};
+    return names[e];
+}
+
+/* Running sums of one view sample's estimator, per batch (core/sampling's
+ * independent randomisations) and colour channel: weights W and weighted
+ * values X. Visibility: w the light sample's colour weight, x 1 (lit) or 0;
+ * irradiance: w 1, x the sample's contribution. */
 typedef struct Accum {
-    double w[3], wv[3], w2[3]; /* visibility: weights, weighted hits, squared weights */
-    double c[3], c2[3];        /* irradiance: contributions and their squares */
+    double w[SAMPLING_MAX_BATCHES][3], x[SAMPLING_MAX_BATCHES][3];
+    double w2[3]; /* squared weights: the binomial's n_eff */
+    double x2[3]; /* squared values: independent samples' variance (irradiance, w = 1) */
     int n;
 } Accum;
 
-/* valid: the lanes traced. below_horizon: light samples drawn but not
+/* valid: the lanes traced. below: lanes whose light sample was drawn but not
  * traced, on or below the receiver's geometric tangent plane. */
 typedef struct Batch {
     LightSample ls[PACKET];
     _Alignas(64) struct RTCRay16 ray;
     _Alignas(64) int valid[PACKET];
-    int below_horizon;
+    bool below[PACKET];
+    int below_horizon; /* how many lanes are below */
 } Batch;
 
 /* Embree reads every lane: keep untraced ones finite and empty. */
 static void empty_lane(Batch *b, int k)
 {
     b->valid[k] = 0;
+    b->below[k] = false;
     b->ray.org_x[k] = b->ray.org_y[k] = b->ray.org_z[k] = 0.0f;
     b->ray.dir_x[k] = b->ray.dir_y[k] = 0.0f; b->ray.dir_z[k] = 1.0f;
     b->ray.tnear[k] = b->ray.tfar[k] = b->ray.time[k] = 0.0f;
@@ -69,6 +81,7 @@ static void aim_lane(Batch *b, int k, vec3 org, const LightSample *s)
 {
     b->ls[k] = *s;
     b->valid[k] = -1;
+    b->below[k] = false;
     b->ray.org_x[k] = org.x; b->ray.org_y[k] = org.y; b->ray.org_z[k] = org.z;
     b->ray.dir_x[k] = s->dir_world.x; b->ray.dir_y[k] = s->dir_world.y; b->ray.dir_z[k] = s->dir_world.z;
     b->ray.tnear[k] = 0.0f;
@@ -85,7 +98,8 @@ static void aim_lane(Batch *b, int k, vec3 org, const LightSample *s)
  * ratio over the samples above the plane, the visible fraction of the part
  * of the light above it. Light samples are equally weighted points of an R2,
  * stratified or independent pattern over the light, so dropping some keeps
- * that ratio consistent (unbiased given the count kept); irradiance counts
+ * that ratio consistent (unbiased given the count kept; the batches' ratio
+ * estimator takes their unequal counts, see batch_spread); irradiance counts
  * them as zero terms of its mean (accumulate_irradiance). So the receiver's
  * caster flag no longer decides its own horizon: the rays traced leave
  * above the plane, where a convex mesh cannot block them, and a receiver
@@ -102,6 +116,7 @@ static void fill_batch(Batch *b, const Light *l, vec3 org, vec3 p, vec3 n_geom, 
         LightSample s = light_sample(l, p, u, v);
         if (v3_dot(n_geom, s.dir_world) <= 0.0f) {
             empty_lane(b, k);
+            b->below[k] = true;
             b->below_horizon++;
         } else aim_lane(b, k, org, &s);
     }
@@ -110,7 +125,8 @@ static void fill_batch(Batch *b, const Light *l, vec3 org, vec3 p, vec3 n_geom, 
 /* A part of the light above the horizon too thin for any of the pattern's
  * samples (visibility's ratio would be 0/0): the visible fraction of a part
  * shrinking to a point tends to that point's visibility, so one ray toward
- * the light's highest point, reported with the error of one draw. */
+ * the light's highest point, reported with the error of one draw
+ * (one_draw_error). */
 static void fill_highest(Batch *b, const Light *l, vec3 org, vec3 p, vec3 n_geom)
 {
     LightSample s = light_sample_highest(l, p, n_geom);
@@ -119,65 +135,114 @@ static void fill_highest(Batch *b, const Light *l, vec3 org, vec3 p, vec3 n_geom
     for (int k = 1; k < PACKET; k++) empty_lane(b, k);
 }
 
-/* Visibility sums of the `nc` channels the reference stores. */
-static void accumulate_visibility(Accum *a, const Batch *b, int nc)
+static void add_sample(Accum *a, int batch, const float *w, const double *x, int nc)
 {
-    for (int k = 0; k < PACKET; k++) {
+    for (int c = 0; c < nc; c++) {
+        a->w[batch][c] += w[c];
+        a->x[batch][c] += w[c] * x[c];
+        a->w2[c] += (double)w[c] * w[c];
+        a->x2[c] += x[c] * x[c];
+    }
+    a->n++;
+}
+
+/* Batch of the sample after one of batch `batch`: core/sampling deals samples
+ * i into batches i % m, so consecutive lanes take consecutive batches. */
+static int next_batch(int batch, int m) { return batch + 1 == m ? 0 : batch + 1; }
+
+/* Visibility of the `nc` channels the reference stores; the packet's lane 0
+ * is in batch `batch` of m. */
+static void accumulate_visibility(Accum *a, const Batch *b, int batch, int m, int nc)
+{
+    for (int k = 0; k < PACKET; k++, batch = next_batch(batch, m)) {
         if (!b->valid[k]) continue;
         const LightSample *s = &b->ls[k];
-        float vis = b->ray.tfar[k] == -INFINITY ? 0.0f : 1.0f; /* Embree marks occluded rays with tfar = -inf */
+        double vis = b->ray.tfar[k] == -INFINITY ? 0.0 : 1.0; /* Embree marks occluded rays with tfar = -inf */
         const float w[3] = {s->vis_weight.x, s->vis_weight.y, s->vis_weight.z};
-        for (int c = 0; c < nc; c++) {
-            a->w[c] += w[c];
-            a->wv[c] += w[c] * vis;
-            a->w2[c] += (double)w[c] * w[c];
-        }
-        a->n++;
+        const double x[3] = {vis, vis, vis};
+        add_sample(a, batch, w, x, nc);
     }
 }
 
 /* Lambertian direct illumination, course Eq. 1.3: E cos / pi per sample. */
-static void accumulate_irradiance(Accum *a, const Batch *b, vec3 n_shading, vec3 albedo)
+static void accumulate_irradiance(Accum *a, const Batch *b, int batch, int m, vec3 n_shading, vec3 albedo)
 {
-    for (int k = 0; k < PACKET; k++) {
+    static const float unit[3] = {1.0f, 1.0f, 1.0f};
+    static const double zero[3] = {0.0, 0.0, 0.0};
+    for (int k = 0; k < PACKET; k++, batch = next_batch(batch, m)) {
+        if (b->below[k]) add_sample(a, batch, unit, zero, 3); /* light below the horizon: a zero term (fill_batch) */
         if (!b->valid[k]) continue;
         const LightSample *s = &b->ls[k];
         float vis = b->ray.tfar[k] == -INFINITY ? 0.0f : 1.0f;
         float cos_p = fmaxf(0.0f, v3_dot(n_shading, s->dir_world));
         const float e[3] = {s->irradiance.x * albedo.x, s->irradiance.y * albedo.y, s->irradiance.z * albedo.z};
-        for (int c = 0; c < 3; c++) {
-            double contrib = e[c] * cos_p * vis * INV_PI;
-            a->c[c] += contrib;
-            a->c2[c] += contrib * contrib;
-        }
-        a->n++;
+        double x[3];
+        for (int c = 0; c < 3; c++) x[c] = e[c] * cos_p * vis * INV_PI;
+        add_sample(a, batch, unit, x, 3);
     }
-    a->n += b->below_horizon; /* light below the horizon: zero terms (fill_batch) */
 }
 
-/* Visibility with a Laplace-smoothed binomial standard error, p~ = (k+1)/(n+2)
- * in weighted form, so an all-lit or all-blocked sample still reports the
- * uncertainty of n draws; n_eff = (sum w)^2 / sum w^2 for weighted samples. */
-static void finish_visibility(const Accum *a, float *value, float *se, int nc)
+/* Standard error of the ratio estimate mean = X / W from m independent
+ * batches, the linearised variance of a ratio estimator over independent
+ * clusters (Cochran, Sampling Techniques, ch. 6): se^2 = m / (m - 1)
+ * sum_b (X_b - W_b mean)^2 / W^2; with equal weights the batch means'
+ * standard deviation over sqrt(m), randomised QMC's error estimate (L'Ecuyer
+ * & Lemieux 2002). It is 0 where every batch agrees: no smoothing floor.
+ * W > 0, m > 1. */
+static double batch_spread(const Accum *a, int c, int m, double mean, double w)
 {
+    double sq = 0;
+    for (int b = 0; b < m; b++) {
+        double d = a->x[b][c] - a->w[b][c] * mean;
+        sq += d * d;
+    }
+    return sqrt(sq * m / (m - 1)) / w;
+}
+
+static double channel_sum(const double (*v)[3], int m, int c)
+{
+    double s = 0;
+    for (int b = 0; b < m; b++) s += v[b][c];
+    return s;
+}
+
+/* Independent samples' visibility error: the Laplace-smoothed binomial, p~ =
+ * (k+1)/(n+2) in weighted form, so an all-lit or all-blocked sample still
+ * reports the uncertainty of n draws; n_eff = (sum w)^2 / sum w^2. */
+static double binomial_error(const Accum *a, int c, double w, double wx)
+{
+    double mean_w = w / a->n;
+    double p_s = (wx + mean_w) / (w + 2.0 * mean_w);
+    double n_eff = w * w / a->w2[c];
+    return sqrt(p_s * (1.0 - p_s) / n_eff);
+}
+
+/* Independent samples' irradiance error: sample variance over n (w = 1). */
+static double sample_variance_error(const Accum *a, int c, double mean)
+{
+    if (a->n < 2) return 0.0;
+    double var = fmax(0.0, (a->x2[c] / a->n - mean * mean) * a->n / (a->n - 1));
+    return sqrt(var / a->n);
+}
+
+/* The error of the one ray toward the light's highest point (fill_highest):
+ * the Laplace-smoothed binomial of one draw, p~ = (k + 1) / 3 for k in {0, 1},
+ * sqrt(p~ (1 - p~)) = sqrt(2) / 3 whatever the ray found. */
+static double one_draw_error(void) { return sqrt(2.0) / 3.0; }
+
+/* Value and standard error per channel, by the reference's estimator (m batches). */
+static void finish(const Accum *a, const Reference *ref, int nc, float *value, float *se)
+{
+    int m = ref->batches;
+    bool irradiance = ref->params.measure == MEASURE_IRRADIANCE;
     for (int c = 0; c < nc; c++) {
-        if (a->w[c] <= 0.0) { value[c] = 1.0f; se[c] = 0.0f; continue; } /* a black light texel set: nothing to block */
-        double mean_w = a->w[c] / a->n;
-        double p = a->wv[c] / a->w[c];
-        double p_s = (a->wv[c] + mean_w) / (a->w[c] + 2.0 * mean_w);
-        double n_eff = a->w[c] * a->w[c] / a->w2[c];
-        value[c] = (float)p;
-        se[c] = (float)sqrt(p_s * (1.0 - p_s) / n_eff);
-    }
-}
-
-static void finish_irradiance(const Accum *a, float *value, float *se)
-{
-    for (int c = 0; c < 3; c++) {
-        double mean = a->c[c] / a->n;
-        double var = a->n > 1 ? fmax(0.0, (a->c2[c] / a->n - mean * mean) * a->n / (a->n - 1)) : 0.0;
+        double w = channel_sum(a->w, m, c), wx = channel_sum(a->x, m, c);
+        if (w <= 0.0) { value[c] = 1.0f; se[c] = 0.0f; continue; } /* a black light texel set: nothing to block */
+        double mean = wx / w;
         value[c] = (float)mean;
-        se[c] = (float)sqrt(var / a->n);
+        if (ref->estimator == REF_ERROR_EXACT) se[c] = 0.0f;
+        else if (ref->estimator == REF_ERROR_RQMC) se[c] = (float)batch_spread(a, c, m, mean, w);
+        else se[c] = (float)(irradiance ? sample_variance_error(a, c, mean) : binomial_error(a, c, w, wx));
     }
 }
 
@@ -198,26 +263,29 @@ static int trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx,
     vec3 p = j->vs->p_world[s], ng = j->vs->n_geom_world[s];
     vec3 org = v3_madd(p, ng, rt_ray_offset(j->extent, p));
     uint32_t stream = sampling_stream(j->p->seed, (uint32_t)s);
-    int nc = j->out->value.channels;
+    int nc = j->out->value.channels, m = j->out->batches;
     Accum a = {0};
     int rays = 0;
     for (int first = 0; first < j->count; first += PACKET) {
         fill_batch(b, j->light, org, p, ng, stream, first, j->count, j->p);
         rays += (j->count - first < PACKET ? j->count - first : PACKET) - b->below_horizon;
         rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
+        int batch = sampling_batch_of(j->p->pattern, first, j->count);
         if (j->p->measure == MEASURE_IRRADIANCE)
-            accumulate_irradiance(&a, b, j->vs->n_shading_world[s], j->scene->objects[j->vs->object[s]].albedo);
-        else accumulate_visibility(&a, b, nc);
-    }
-    if (rays == 0 && j->p->measure == MEASURE_VISIBILITY) {
-        fill_highest(b, j->light, org, p, ng);
-        rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
-        accumulate_visibility(&a, b, nc);
-        rays = 1;
+            accumulate_irradiance(&a, b, batch, m, j->vs->n_shading_world[s],
+                                  j->scene->objects[j->vs->object[s]].albedo);
+        else accumulate_visibility(&a, b, batch, m, nc);
     }
     float *v = j->out->value.data + (size_t)s * nc, *se = j->out->std_error.data + (size_t)s * nc;
-    if (j->p->measure == MEASURE_IRRADIANCE) finish_irradiance(&a, v, se);
-    else finish_visibility(&a, v, se, nc);
+    bool sliver = rays == 0 && j->p->measure == MEASURE_VISIBILITY;
+    if (sliver) {
+        fill_highest(b, j->light, org, p, ng);
+        rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
+        accumulate_visibility(&a, b, 0, m, nc);
+        rays = 1;
+    }
+    finish(&a, j->out, nc, v, se);
+    for (int c = 0; sliver && c < nc; c++) se[c] = (float)one_draw_error();
     return rays;
 }
 
@@ -252,8 +320,10 @@ bool reference_compute(const RtScene *casters, const Scene *scene, int light_ind
     }
     out->params = *p;
     const Light *l = &scene->lights[light_index];
-    RefJob j = {rt_scene_handle(casters), scene, l, vs, p, light_is_delta(l) ? 1 : p->samples,
-                scene_extent(scene), out};
+    out->rays_per_sample = light_is_delta(l) ? 1 : p->samples;
+    out->batches = sampling_batches(p->pattern, out->rays_per_sample);
+    out->estimator = light_is_delta(l) ? REF_ERROR_EXACT : out->batches > 1 ? REF_ERROR_RQMC : REF_ERROR_INDEPENDENT;
+    RefJob j = {rt_scene_handle(casters), scene, l, vs, p, out->rays_per_sample, scene_extent(scene), out};
     Progress prog;
     progress_begin(&prog, "reference", vs->height);
     long long rays = 0;

@@ -22,11 +22,25 @@ typedef struct ReferenceParams {
 
 #define REFERENCE_MAX_SAMPLES 1048576
 
+/* How std_error is estimated. */
+typedef enum RefErrorEstimator {
+    REF_ERROR_EXACT,       /* a delta light: its one ray is the answer, error 0 */
+    REF_ERROR_INDEPENDENT, /* one batch of independent samples: Laplace-smoothed binomial (visibility) or the
+                            * sample variance (irradiance), over n */
+    REF_ERROR_RQMC,        /* randomised QMC: the spread of `batches` independent randomisations (see
+                            * core/sampling.h) over sqrt(batches); 0 where all batches agree */
+} RefErrorEstimator;
+#define REF_ERROR_ESTIMATOR_COUNT 3
+const char *ref_error_estimator_name(RefErrorEstimator e);
+
 typedef struct Reference {
     Image value;     /* visibility in [0,1] (1 or 3 channels) or outgoing radiance (3) */
     Image std_error; /* standard error of value, same shape */
     ReferenceParams params;
     long long rays;  /* occlusion rays traced */
+    int rays_per_sample;         /* params.samples, or 1 for a delta light */
+    RefErrorEstimator estimator; /* how std_error was estimated */
+    int batches;                 /* independent randomisations (RQMC), else 1 */
 } Reference;
 
 bool reference_params_check(const ReferenceParams *p, Error *err);

@@ -368,7 +368,7 @@ end)
 
 local function fake_row(scene, samples, noise)
   return { record = { scene = { name = scene, width = 40, height = 30 }, reference = { samples = samples },
-                      metrics = { noise_rms = noise } } }
+                      metrics = { all = { noise_rms = noise } } } }
 end
 
 local function read_all(path)
@@ -395,6 +395,18 @@ test("plot_subtitles_state_scene_resolution_samples_and_noise_from_the_rows", fu
   plot.draw(tmp .. "/plots", "closed", { title = "T", xlabel = "x", ylabel = "y", series = series,
                                          analytic = "y = x^2" })
   assert(read_all(tmp .. "/plots/closed.gp"):find("closed form: y = x^2", 1, true))
+end)
+
+test("plot_subtitles_say_one_exact_ray_for_delta_lights_and_skip_absent_noise", function()
+  local plot, json = require "shadowlab.plot", require "shadowlab.json"
+  local delta = { record = { scene = { name = "cones", width = 40, height = 30 },
+                             reference = { samples = 1024, std_error = "exact" },
+                             metrics = { all = { noise_rms = 0 }, penumbra = { count = 0, noise_rms = json.null } } } }
+  assert(plot.caption({ delta }) == "cones 40x30, reference one exact ray (delta light), noise rms 0.0000",
+         plot.caption({ delta }))
+  local penumbra = { label = "noise rms (penumbra)", value = function(rec) return rec.metrics.penumbra.noise_rms end }
+  local text = plot.caption({ delta }, nil, penumbra)
+  assert(text == "cones 40x30, reference one exact ray (delta light), noise rms (penumbra) none", text)
 end)
 
 test("plot_images_appear_whole_or_not_at_all", function()

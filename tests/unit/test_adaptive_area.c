@@ -72,7 +72,7 @@ TEST(test_adaptive_area_parallel_planes_within_the_sampling_bound)
     CHECK(soft_metrics(lab, &fixed.visibility, REF_SAMPLES, &mf) &&
           soft_metrics(lab, &adaptive.visibility, REF_SAMPLES, &ma));
     const ErrorStats *pf = &mf.region[REGION_PENUMBRA], *pa = &ma.region[REGION_PENUMBRA];
-    double noise = mf.noise_rms;
+    double noise = pf->noise_rms;
     printf("    penumbra %ld samples, noise rms %.4f: fixed 2 MAE %.4f max %.4f; adaptive MAE %.4f max %.4f\n",
            pf->count, noise, pf->mae, pf->max_abs, pa->mae, pa->max_abs);
     CHECK(pf->count > 1000);
@@ -171,7 +171,7 @@ TEST(test_adaptive_area_overlap_breaks_the_parallel_planes_bound)
     Image ea, eb;
     CHECK(signed_error(strip, &a.visibility, REF_SAMPLES, &ma, &ea));
     CHECK(signed_error(overlap, &b.visibility, REF_SAMPLES, &mb, &eb));
-    double bound = 1.0 / 32 + 0.004 + 4 * fmax(ma.noise_rms, mb.noise_rms);
+    double bound = 1.0 / 32 + 0.004 + 4 * fmax(ma.region[REGION_PENUMBRA].noise_rms, mb.region[REGION_PENUMBRA].noise_rms);
     long over_strip = signed_error_count(&ea, -bound, bound), over_overlap = signed_error_count(&eb, -bound, bound);
     printf("    |e| > %.3f: strip %ld of %ld samples, overlap %ld of %ld (penumbra %ld, max %.3f, umbra leak %.4f)\n",
            bound, over_strip, ma.class_count[SAMPLE_LIT_CANDIDATE], over_overlap, mb.class_count[SAMPLE_LIT_CANDIDATE],

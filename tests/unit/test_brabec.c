@@ -26,10 +26,10 @@ TEST(test_brabec_is_close_to_the_reference_at_a_straight_edge)
     double bound = 0.0394 + 0.375 / w;
     const ErrorStats *pe = &m.region[REGION_PENUMBRA];
     printf("    half-penumbra %.2f texels: penumbra %ld samples, max |e| %.4f, RMSE %.4f; bound %.4f + noise %.4f\n", w,
-           pe->count, pe->max_abs, pe->rmse, bound, m.noise_rms);
+           pe->count, pe->max_abs, pe->rmse, bound, pe->noise_rms);
     CHECK(pe->count > 1000);
-    CHECK_MSG(pe->max_abs <= bound + 3 * m.noise_rms, "max |e| %.4f above %.4f", pe->max_abs, bound);
-    CHECK(m.region[REGION_UMBRA].mae < 0.01 && m.region[REGION_LIT].mae < 0.01);
+    CHECK_MSG(pe->max_abs <= bound + 3 * pe->noise_rms, "max |e| %.4f above %.4f", pe->max_abs, bound);
+    CHECK((m.region[REGION_UMBRA].count == 0 || m.region[REGION_UMBRA].mae < 0.01) && m.region[REGION_LIT].mae < 0.01);
     render_result_free(&r);
     lab_close(lab);
 }

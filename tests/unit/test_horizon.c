@@ -140,7 +140,10 @@ static double unblocked_irradiance(const Light *l, vec3 p, vec3 n_geom, vec3 n_s
 
 /* Irradiance counts the light below the horizon as zero terms of its mean
  * (not as fewer terms): at terminator samples on the ball it matches the
- * quadrature within 4 standard errors, with and without the ball casting. */
+ * quadrature within 4 standard errors plus 0.1% of the brightest one's
+ * irradiance, with and without the ball casting. The floor is absolute: a
+ * sliver of light above the plane that no pattern sample hits (1e-4 against
+ * 0.04 at 256 samples) reads 0 with every batch agreeing. */
 TEST(test_horizon_irradiance_counts_the_horizon_as_zero)
 {
     Lab *labs[2] = {ball_lab(SPHERE_OVERHEAD, true), ball_lab(SPHERE_OVERHEAD, false)};
@@ -151,17 +154,20 @@ TEST(test_horizon_irradiance_counts_the_horizon_as_zero)
     const Reference *ref[2] = {reference(labs[0], MEASURE_IRRADIANCE), reference(labs[1], MEASURE_IRRADIANCE)};
     CHECK(vs && term && ref[0] && ref[1]);
     const Light *l = &lab_scene(labs[0])->lights[0];
-    double albedo = lab_scene(labs[0])->objects[BALL].albedo.x, worst = 0;
-    int checked = 0;
+    double albedo = lab_scene(labs[0])->objects[BALL].albedo.x, worst = 0, peak = 0, exact[60];
+    int checked = 0, at[60];
     for (int s = 0; s < vs->count && checked < 60; s += 7) {
         if (!term[s] || vs->object[s] != BALL) continue;
-        double exact = unblocked_irradiance(l, vs->p_world[s], vs->n_geom_world[s], vs->n_shading_world[s], albedo);
-        for (int c = 0; c < 2; c++) {
-            double e = fabs(ref[c]->value.data[(size_t)s * 3] - exact), se = ref[c]->std_error.data[(size_t)s * 3];
-            worst = fmax(worst, e / (se + 1e-3 * exact + 1e-9));
-        }
-        checked++;
+        exact[checked] = unblocked_irradiance(l, vs->p_world[s], vs->n_geom_world[s], vs->n_shading_world[s], albedo);
+        peak = fmax(peak, exact[checked]);
+        at[checked++] = s;
     }
+    for (int i = 0; i < checked; i++)
+        for (int c = 0; c < 2; c++) {
+            size_t k = (size_t)at[i] * 3;
+            double e = fabs(ref[c]->value.data[k] - exact[i]), se = ref[c]->std_error.data[k];
+            worst = fmax(worst, e / (se + 1e-3 * peak + 1e-9));
+        }
     printf("    %d terminator samples, worst |reference - quadrature| = %.2f (standard error + 0.1%%)\n", checked, worst);
     CHECK_MSG(checked >= 30, "only %d terminator samples checked", checked);
     CHECK_MSG(worst <= 4.0, "irradiance off the quadrature by %.2f standard errors", worst);

@@ -176,7 +176,7 @@ TEST(test_shadow_width_parallel_planes_inner_penumbra_model)
         CHECK(render_darker(lab, p, &m, &darker));
         const ErrorStats *pe = &m.region[REGION_PENUMBRA];
         printf("    %-20s penumbra %ld: MAE %.4f (model 0.255), %ld darker by > %.2f, lit max %.4f, noise %.4f\n",
-               props[k], pe->count, pe->mae, darker, DARK_MARGIN, m.region[REGION_LIT].max_abs, m.noise_rms);
+               props[k], pe->count, pe->mae, darker, DARK_MARGIN, m.region[REGION_LIT].max_abs, pe->noise_rms);
         CHECK(pe->count > 1000);
         CHECK_NEAR(pe->mae, 0.255, 0.03);
         CHECK(darker == 0);
@@ -202,7 +202,7 @@ TEST(test_shadow_width_overlap_united_blockers_over_darken)
     CHECK(render_darker(lab, p, &m, &darker));
     const ErrorStats *pe = &m.region[REGION_PENUMBRA];
     printf("    penumbra %ld: MAE %.4f, over-darkening %.4f, leaks %.4f; %ld samples darker by > %.2f (noise %.4f)\n",
-           pe->count, pe->mae, pe->dark_mean, pe->leak_mean, darker, DARK_MARGIN, m.noise_rms);
+           pe->count, pe->mae, pe->dark_mean, pe->leak_mean, darker, DARK_MARGIN, pe->noise_rms);
     CHECK_MSG(darker > pe->count / 50, "only %ld samples over-darkened", darker);
     lab_close(lab);
 }

@@ -130,7 +130,7 @@ TEST(test_soft_maps_fail_on_overlap_as_their_papers_predict)
         double rms = sqrt((pe->rmse * pe->rmse * pe->count + ue->rmse * ue->rmse * ue->count) / n);
         printf("    %-12s %-22s: shadowed-region RMSE %.4f (bound %.3f); umbra leak %.4f, penumbra signed %+.4f\n",
                cases[c].tech, cases[c].params[0], rms, cases[c].bound, ue->leak_mean, pe->mean_signed);
-        CHECK_MSG(rms > cases[c].bound + m.noise_rms, "%s: RMSE %.4f not above its bound %.3f", cases[c].tech, rms,
+        CHECK_MSG(rms > cases[c].bound + m.region[REGION_ALL].noise_rms, "%s: RMSE %.4f not above its bound %.3f", cases[c].tech, rms,
                   cases[c].bound);
         if (strcmp(cases[c].params[0], "variant=additive") == 0) /* the bits' gap filling joins the slabs' lexels */
             CHECK_MSG(ue->leak_mean > 0.05, "accumulation's umbra is not lighter than expected (leak %.4f)",
