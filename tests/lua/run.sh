@@ -220,7 +220,7 @@ expect lab_kernel_size_runs 0 "0 failed" "report:" -- \
     "$SL" run experiments/lab-kernel-size.lua --techniques pcf $TINY --out "$TMP/lks"
 expect lab_light_radius_runs_a_shard 0 "0 failed" -- \
     "$SL" run experiments/lab-light-radius.lua $TINY --shard 0/24 --out "$TMP/llr"
-expect defaults_matrix_has_no_unexpected_umbra_leak 0 "0 unexpected umbra leaks above 0.10, 0 failed" -- "$SL" run experiments/defaults-matrix.lua --scenes sphere-on-plane.lua,contact.lua --set camera.width=48 --set camera.height=36 --samples 16 --out "$TMP/dm"
+expect defaults_matrix_has_no_unexpected_umbra_leak 0 "0 unexpected umbra leaks above 0.10, 0 failed" -- "$SL" run experiments/defaults-matrix.lua --scenes sphere-on-plane.lua,contact.lua,textured-light.lua --set camera.width=48 --set camera.height=36 --samples 16 --out "$TMP/dm"
 
 # ---- the report in headless Chromium: every image and plot loads, nothing logged
 browse() { # browse DIR: DOM after load in $TMP/dom.html, browser log in $TMP/browser.log
