@@ -42,8 +42,6 @@ local PCSS_BASELINE = { [true] = "pcss map_size=512", [false] = "pcss map_size=5
 local function build(name, samples, repeats)
   local exp = experiment.new{
     name = name, samples = samples, repeats = repeats, warmup = repeats > 1 and 1 or 0, overrides = OVERRIDES,
-    description = string.format("Seed 000 Fig. 3: accumulation (512^2 map, K = 3..15, additive and occlusion " ..
-                                "bits) against PCSS, reference %d light samples.", samples),
   }
   for _, s in ipairs(SCENES) do exp:scene(s[1], sweep.grid{ ["lights[1].radius"] = s[2] }) end
   exp:add("accumulation", sweep.grid{ K = KS, map_size = { 512 }, variant = { "additive", "occlusion_bits" } })
@@ -71,13 +69,21 @@ local function args_into(argv, sub, default_out)
   return copy
 end
 
+-- The report's description, once the run has fixed the sample count (--samples).
+local function describe(exp)
+  exp.description = string.format("Seed 000 Fig. 3: accumulation (512^2 map, K = 3..15, additive and occlusion " ..
+                                  "bits) against PCSS, reference %d light samples.", exp.samples)
+end
+
 local PAPER_SAMPLES = 64 -- seed 000 §2: "a multisample reference solution obtained with 64 light source samples"
 local converged = build("seed000-fig3", 1024, 5)
 local result = converged:run(args_into(arg, nil, "reports/seed000-fig3"))
 local title = string.format("Seed 000 Fig. 3 against a %d-sample reference", converged.samples)
+describe(converged)
 if result.sharded then return report.write(result, { title = title }) end
 local paper = build("seed000-fig3-ref64", PAPER_SAMPLES, 1) -- errors only: times come from the first run
 local result64 = paper:run(args_into(arg, "ref64", result.out))
+describe(paper)
 report.write(result64, { title = string.format("Seed 000 Fig. 3 against a %d-sample reference (the paper's)",
                                                paper.samples) })
 

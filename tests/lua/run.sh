@@ -205,6 +205,10 @@ for e in seed000-fig3 seed001-adaptive-area seed002-single-sample seed003-shadow
 done
 figure seed000_frame_ratio_to_pcss "$R/seed000-fig3/reproduction.csv" measured 0.05 20 quantity~"frame time / PCSS"
 figure seed000_error_ratio_to_pcss "$R/seed000-fig3/reproduction.csv" measured 0.01 100 quantity~"RMSE / PCSS"
+expect seed000_titles_follow_samples 0 "against a 4-sample reference" "reference 4 light samples" \
+    "against a 64-sample reference (the paper" -- cat "$R/seed000-fig3/index.html" "$R/seed000-fig3/ref64/index.html"
+expect seed001_title_and_table_follow_the_view 0 "under a textured light, 32x24" "by subdivisions (32x24)" -- \
+    cat "$R/seed001-adaptive-area/index.html" "$R/seed001-adaptive-area/table2.md"
 figure seed001_unsubdivided_share "$R/seed001-adaptive-area/reproduction.csv" measured 20 90 item~"no subdivision"
 figure seed001_test_ratios "$R/seed001-adaptive-area/reproduction.csv" measured 0.5 5 quantity~"tests per pixel"
 figure seed002_small_balls_err_more "$R/seed002-single-sample/reproduction.csv" measured 1 1000 quantity~"rho" --hold
