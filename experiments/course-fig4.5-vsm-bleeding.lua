@@ -92,10 +92,10 @@ for _, r in ipairs(result.rows) do
   end
 end
 local LEAKS = reproduce.above("'if the variance is high (one occluder on top of another), light leaks can occur': " ..
-                              "VSM's umbra leak above PCF's")
+                              "VSM's umbra leak above PCF's (a difference: PCF's can be 0)")
 local LESS = reproduce.below("§4.2.2's remedies reduce the leak: below VSM's")
-local claims = { { item = "K = 9: vsm / pcf", quantity = "umbra leak ratio", paper = 1, measured = leak.vsm / leak.pcf,
-                   rule = LEAKS, source = "course §4.2.1, Fig. 4.5" } }
+local claims = { { item = "K = 9: vsm - pcf", quantity = "umbra leak difference", paper = 0,
+                   measured = leak.vsm - leak.pcf, rule = LEAKS, source = "course §4.2.1, Fig. 4.5" } }
 for _, what in ipairs({ "vsm bleed_reduction=0.3", "lvsm layers=4", "evsm", "msm" }) do
   claims[#claims + 1] = { item = "K = 9: " .. what .. " / vsm", quantity = "umbra leak ratio", paper = 1,
                           measured = (leak[what] or 0 / 0) / leak.vsm, rule = LESS, source = "course §4.2.2" }

@@ -220,7 +220,7 @@ figure course_fig2_2_bias_lowers_acne "$R/course-fig2.2-bias/reproduction.csv" m
 figure course_fig2_3_midpoint_fails "$R/course-fig2.3-midpoint/reproduction.csv" measured 0.01 50 \
     item~cones-and-hills quantity~"false lit"
 figure course_fig4_3_umbra_ratio "$R/course-fig4.3-pcf-umbra/reproduction.csv" measured 0.2 5 quantity~umbra
-figure course_fig4_5_vsm_leaks "$R/course-fig4.5-vsm-bleeding/reproduction.csv" measured 1 100 item~"vsm / pcf" --hold
+figure course_fig4_5_vsm_leaks "$R/course-fig4.5-vsm-bleeding/reproduction.csv" measured 0.001 1 item~"vsm - pcf" --hold
 figure course_fig4_7_gibbs_overshoot "$R/course-fig4.7-csm-terms/reproduction.csv" measured 8.5 9.5 \
     item~"M = 32" quantity~overshoot --hold
 figure course_fig4_7_leak_ratio "$R/course-fig4.7-csm-terms/reproduction.csv" measured 0 10 quantity~"umbra leak"
