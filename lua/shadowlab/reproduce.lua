@@ -100,7 +100,7 @@ local function judge(row)
   j.paper_text = row.rule.shows(row.paper)
   j.measured_text = shown(row.measured)
   j.ratio_text = j.ratio == j.ratio and string.format("%.3g", j.ratio) or "-"
-  j.quantity = (row.quantity or "") .. ((row.unit and row.unit ~= "") and " (" .. row.unit .. ")" or "")
+  j.quantity_text = (row.quantity or "") .. ((row.unit and row.unit ~= "") and " (" .. row.unit .. ")" or "")
   return j
 end
 
@@ -109,7 +109,7 @@ function reproduce.failed(verdict)
   return verdict:find("^differs") ~= nil or verdict:find("^trend differs") ~= nil or verdict == "not measured"
 end
 
-local COLUMNS = { { "item", "item" }, { "quantity", "quantity" }, { "paper", "paper_text" },
+local COLUMNS = { { "item", "item" }, { "quantity", "quantity_text" }, { "paper", "paper_text" },
                   { "measured", "measured_text" }, { "measured / paper", "ratio_text" }, { "verdict", "verdict" },
                   { "source", "source" } }
 
@@ -184,7 +184,7 @@ function reproduce.compare(rows, opts)
     csv[#csv + 1] = table.concat({ csv_field(r.item), csv_field(r.quantity or ""), csv_field(r.unit or ""),
                                    csv_number(r.paper), csv_number(r.measured), csv_number(r.ratio),
                                    csv_field(r.rule.text), csv_field(r.verdict), csv_field(r.source) }, ",")
-    md[#md + 1] = string.format("| %s | %s | %s | %s | %s | %s | %s |", r.item, r.quantity, r.paper_text,
+    md[#md + 1] = string.format("| %s | %s | %s | %s | %s | %s | %s |", r.item, r.quantity_text, r.paper_text,
                                 r.measured_text, r.ratio_text, r.verdict, r.source)
     html[#html + 1] = "<tr>"
     for _, col in ipairs(COLUMNS) do html[#html + 1] = "<td>" .. esc(r[col[2]]) .. "</td>" end
