@@ -10,11 +10,13 @@
 -- 2 cm plate on the floor, light shrunk to 1 cm so the reference is a hard
 -- shadow) and cones-and-hills.lua (a grazing spot).
 --   build/shadowlab run experiments/course-fig2.3-midpoint.lua [--resume] ...
--- Writes reports/course-fig2.3-midpoint/: index.html and figure.html.
+-- Writes reports/course-fig2.3-midpoint/: index.html, figure.html and
+-- reproduction.{md,csv} (the figure's claims at 1024^2).
 local sl = require "shadowlab"
 local sweep = require "shadowlab.sweep"
 local experiment = require "shadowlab.experiment"
 local report = require "shadowlab.report"
+local reproduce = require "shadowlab.reproduce"
 local figures = dofile(sl.root .. "/experiments/lib/figures.lua")
 
 local SIZES = { 256, 512, 1024, 2048 }
@@ -71,4 +73,29 @@ for _, scene in ipairs({ "contact", "cones-and-hills" }) do
   end
   page:table({ "layers", "map size", "false lit %", "false shadow %", "RMSE" }, rows_table)
 end
+-- Course §2.1.2, Fig. 2.3 (no figures given): the midpoint needs no bias against acne, but fails both ways.
+local at = {} -- "scene|mode" -> the 1024^2 row
+for _, r in ipairs(result.rows) do
+  if r.status == "ok" and r.params.map_size == 1024 then at[r.variant.scene .. "|" .. mode(r)] = r end
+end
+local claims = {}
+local FEWER = reproduce.below("the map 'can then be safely set to the average distance' (Woo 1992), no bias: " ..
+                              "its false shadow below a bias-free single map's")
+local FAILS = reproduce.above("Fig. 2.3's two failure cases occur: a share above 0")
+for _, scene in ipairs({ "contact", "cones-and-hills" }) do
+  local mid, single = at[scene .. "|midpoint"], at[scene .. "|single"]
+  if mid and single then
+    claims[#claims + 1] = { item = scene .. ", 1024^2: midpoint / single (no bias)", quantity = "false shadow ratio",
+                            paper = 1, measured = figures.acne(mid) / figures.acne(single), rule = FEWER,
+                            source = "course §2.1.2" }
+    claims[#claims + 1] = { item = scene .. ", 1024^2 midpoint: incorrect unshadowing", quantity = "false lit",
+                            unit = "%", paper = 0, measured = 100 * figures.leaks(mid), rule = FAILS,
+                            source = "course Fig. 2.3 (left)" }
+    claims[#claims + 1] = { item = scene .. ", 1024^2 midpoint: incorrect self-shadowing", quantity = "false shadow",
+                            unit = "%", paper = 0, measured = 100 * figures.acne(mid), rule = FAILS,
+                            source = "course Fig. 2.3 (right)" }
+  end
+end
+page:text(reproduce.compare(claims, { out = result.out, title = "Course Fig. 2.3",
+                                      note = "sm without bias, shares of the light-facing samples." }).html)
 page:write()

@@ -24,6 +24,7 @@
 local sl = require "shadowlab"
 local plot = require "shadowlab.plot"
 local flags = require "shadowlab.flags"
+local reproduce = require "shadowlab.reproduce"
 
 local opt = flags.parse(arg, { out = "reports/fig3-13", points = 24 }, "fig3-13")
 local out, points = opt.out, math.tointeger(opt.points)
@@ -122,3 +123,32 @@ sl.write_file(out .. "/convergence.csv", table.concat(conv_csv, "\n") .. "\n")
 sl.write_file(out .. "/summary.md", table.concat(md, "\n") .. "\n")
 print(table.concat(md, "\n"))
 print("wrote " .. out .. "/{storage.csv,convergence.csv,summary.md,plots/}")
+
+-- Paper against measured: Fig. 3.13 has no numeric axes (catalogue §6), so its claims as storage-factor ratios,
+-- read back from storage.csv's lines: light, scheme, maps -> storage factor.
+local sf = {}
+for i = 2, #csv do
+  local light, scheme, maps, factor = csv[i]:match("^([^,]*),([^,]*),([^,]*),([^,]*)")
+  sf[light .. "|" .. scheme .. "|" .. maps] = tonumber(factor)
+end
+local function ratio(a, b) return (sf[a] or 0 / 0) / (sf[b] or 0 / 0) end
+local BETTER = reproduce.below("a storage-factor ratio below 1")
+local NO_WARP = reproduce.within(0.1, "'no warping possible': warping leaves the storage factor within 10%")
+local claims = {
+  { item = "overhead: W / ZP, one map", quantity = "storage factor ratio", paper = 1,
+    measured = ratio("overhead|W|1", "overhead|ZP|1"), rule = BETTER,
+    source = "course §3.2.3.3, Fig. 3.13 (overhead light 'ideal for warping')" },
+  { item = "behind: W / ZP, one map", quantity = "storage factor ratio", paper = 1,
+    measured = ratio("behind|W|1", "behind|ZP|1"), rule = NO_WARP, source = "course §3.2.3.3, Fig. 3.13" },
+}
+for _, light in ipairs({ "overhead", "behind" }) do
+  claims[#claims + 1] = { item = light .. string.format(": ZP, %d maps / 1 map", MAX_MAPS),
+                          quantity = "storage factor ratio", paper = 1,
+                          measured = ratio(light .. "|ZP|" .. MAX_MAPS, light .. "|ZP|1"), rule = BETTER,
+                          source = "course §3.2.3.3, Figs. 3.12-3.13 (z-partitioning 'still improves quality')" }
+end
+claims[#claims + 1] = { item = "overhead: ZP+W / ZP, 4 maps", quantity = "storage factor ratio", paper = 1,
+                        measured = ratio("overhead|ZP+W|4", "overhead|ZP|4"), rule = BETTER,
+                        source = "course §3.2.3.3, Figs. 3.11 and 3.13 (warping 'can further improve' ZP)" }
+reproduce.compare(claims, { out = out, title = "Course Fig. 3.13",
+                            note = string.format("scenes/frustum-box.lua, %d^3 frustum points.", points) })

@@ -158,6 +158,7 @@ function html.write_index(path, doc)
   out[#out + 1] = '<p>Data: <a href="results.csv">results.csv</a> · <a href="records.jsonl">records.jsonl</a> ' ..
                   "(one JSON record per configuration, with every parameter, timing and resource).</p>"
   out[#out + 1] = definitions
+  if doc.opts.reproduction then out[#out + 1] = doc.opts.reproduction.html end -- reproduce.compare's table
   out[#out + 1] = "<h2>" .. esc(doc.err_label) .. " against " .. esc(doc.time_label) .. "</h2><div class=\"plots\">"
   for _, p in ipairs(doc.plots.time) do plot_block(p.file, out) end
   out[#out + 1] = "</div>"

@@ -222,6 +222,72 @@ expect lab_light_radius_runs_a_shard 0 "0 failed" -- \
     "$SL" run experiments/lab-light-radius.lua $TINY --shard 0/24 --out "$TMP/llr"
 expect defaults_matrix_has_no_unexpected_umbra_leak 0 "0 unexpected umbra leaks above 0.10, 0 failed" -- "$SL" run experiments/defaults-matrix.lua --scenes sphere-on-plane.lua,contact.lua,textured-light.lua --set camera.width=48 --set camera.height=36 --samples 16 --out "$TMP/dm"
 
+# figure NAME CSV COLUMN LO HI [COL~TEXT ...] [--hold]: a figure the experiment computed, finite and in range
+figure() { name=$1; shift; expect "$name" 0 "figures checked" -- "$SL" run tests/lua/figure.lua "$@"; }
+figure lab_kernel_size_rmse_in_range "$TMP/lks/results.csv" rmse 0 1 technique~pcf
+
+# ---- the reproductions at tiny settings, in two lanes (one per core), checked once both are done:
+# each runs, prints and writes paper against measured (reproduce.lua), and a figure it computed is in range
+R=$TMP/repro
+mkdir -p "$R"
+TINYQ="$TINY --quiet --threads 1"
+run_repro() { # run_repro EXPERIMENT ARGS...: its output in $R/EXPERIMENT.log, its exit status in .rc
+    e=$1; shift
+    "$SL" run "experiments/$e.lua" "$@" --out "$R/$e" >"$R/$e.log" 2>&1
+    echo $? >"$R/$e.rc"
+}
+(
+    run_repro fig3-13-storage-factor --points 6
+    run_repro seed003-shadow-width $TINYQ
+    run_repro course-fig2.2-bias $TINYQ
+    run_repro course-fig2.3-midpoint $TINYQ
+    run_repro course-fig4.5-vsm-bleeding --map-size 128 $TINYQ
+    run_repro fig3-7-aliasing-vs-z --map-size 256
+) &
+lane=$!
+run_repro seed000-fig3 $TINYQ
+run_repro seed001-adaptive-area $TINYQ
+run_repro seed002-single-sample $TINYQ
+run_repro seed003-table1 --reps 1 --view 16 --sizes 256,512 --scenes scenes/sphere-on-plane.lua
+run_repro course-fig4.3-pcf-umbra --set camera.width=80 --set camera.height=60 --samples 32 --repeats 1 --warmup 0 \
+    --no-images --quiet --threads 1 # 32x24 and 4 samples leave no penumbra to compare
+run_repro course-fig4.7-csm-terms --map-size 128 $TINYQ
+run_repro fig3-10-12-partitions $TINYQ
+wait "$lane"
+for e in seed000-fig3 seed001-adaptive-area seed002-single-sample seed003-shadow-width seed003-table1 \
+         course-fig2.2-bias course-fig2.3-midpoint course-fig4.3-pcf-umbra course-fig4.5-vsm-bleeding \
+         course-fig4.7-csm-terms fig3-7-aliasing-vs-z fig3-10-12-partitions fig3-13-storage-factor; do
+    expect "${e}_reproduces" 0 "paper against measured" "reproduction:" -- \
+        sh -c 'cat "$1.log"; exit "$(cat "$1.rc" 2>/dev/null || echo 1)"' sh "$R/$e"
+done
+# (figures from timings are checked finite and positive only: no timing assertions)
+figure seed000_frame_ratio_to_pcss "$R/seed000-fig3/reproduction.csv" measured 1e-9 1e9 quantity~"frame time / PCSS"
+figure seed000_error_ratio_to_pcss "$R/seed000-fig3/reproduction.csv" measured 0.01 100 quantity~"RMSE / PCSS"
+expect seed000_titles_follow_samples 0 "against a 4-sample reference" "reference 4 light samples" \
+    "against a 64-sample reference (the paper" -- cat "$R/seed000-fig3/index.html" "$R/seed000-fig3/ref64/index.html"
+expect seed001_title_and_table_follow_the_view 0 "under a textured light, 32x24" "by subdivisions (32x24)" -- \
+    cat "$R/seed001-adaptive-area/index.html" "$R/seed001-adaptive-area/table2.md"
+figure seed001_unsubdivided_share "$R/seed001-adaptive-area/reproduction.csv" measured 20 90 item~"no subdivision"
+figure seed001_test_ratios "$R/seed001-adaptive-area/reproduction.csv" measured 0.5 5 quantity~"tests per pixel"
+figure seed002_small_balls_err_more "$R/seed002-single-sample/reproduction.csv" measured 1 1000 quantity~"rho" --hold
+figure seed002_frame_ratio "$R/seed002-single-sample/reproduction.csv" measured 1e-9 1e9 quantity~"frame time"
+figure seed003_error_ratios "$R/seed003-shadow-width/reproduction.csv" measured 0.05 20 quantity~"MAE ratio"
+figure seed003_table1_frame_ratios "$R/seed003-table1/reproduction.csv" measured 1e-9 1e9 quantity~"frame time ratio"
+figure course_fig2_2_bias_lowers_acne "$R/course-fig2.2-bias/reproduction.csv" measured 0 0.5 \
+    item~cones-and-hills quantity~acne --hold
+figure course_fig2_3_midpoint_fails "$R/course-fig2.3-midpoint/reproduction.csv" measured 0.01 50 \
+    item~cones-and-hills quantity~"false lit"
+figure course_fig4_3_umbra_ratio "$R/course-fig4.3-pcf-umbra/reproduction.csv" measured 0.2 5 quantity~umbra
+figure course_fig4_5_vsm_leaks "$R/course-fig4.5-vsm-bleeding/reproduction.csv" measured 0.001 1 item~"vsm - pcf" --hold
+figure course_fig4_7_gibbs_overshoot "$R/course-fig4.7-csm-terms/reproduction.csv" measured 8.5 9.5 \
+    item~"M = 32" quantity~overshoot --hold
+figure course_fig4_7_leak_ratio "$R/course-fig4.7-csm-terms/reproduction.csv" measured 0 10 quantity~"umbra leak"
+figure fig3_7_lispsm_product "$R/fig3-7-aliasing-vs-z/reproduction.csv" measured 95 103 \
+    item~LiSPSM quantity~"max e_x x" --hold
+figure fig3_13_no_warping_behind "$R/fig3-13-storage-factor/reproduction.csv" measured 0.9 1.1 item~"behind: W" --hold
+figure fig3_10_12_lispsm_helps_high_sun "$R/fig3-10-12-partitions/reproduction.csv" measured 0 1 \
+    item~"high-sun: LiSPSM" --hold
+
 # ---- the report in headless Chromium: every image and plot loads, nothing logged
 browse() { # browse DIR: DOM after load in $TMP/dom.html, browser log in $TMP/browser.log
     rm -rf "$TMP/profile"

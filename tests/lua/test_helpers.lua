@@ -424,6 +424,42 @@ test("plot_images_appear_whole_or_not_at_all", function()
   for _, name in ipairs(sl.dir(dir)) do assert(not name:find("partial", 1, true), "left behind: " .. name) end
 end)
 
+---------------------------------------------------------------- reproduce
+
+test("reproduce_judges_each_rule_and_writes_one_csv_row_per_item", function()
+  local reproduce = require "shadowlab.reproduce"
+  local dir = tmp .. "/reproduce"
+  local src = "test"
+  local rows = {
+    { item = "equal", paper = 2, measured = 2.1, rule = reproduce.within(0.1), source = src },
+    { item = "far", paper = 2, measured = 3, rule = reproduce.within(0.1), source = src },
+    { item = "in size", paper = 2, measured = 3, rule = reproduce.factor(2), source = src },
+    { item = "grows", paper = 3, measured = 1.2, rule = reproduce.trend(0.5), source = src },
+    { item = "grows, close", paper = 1.8, measured = 1.7, rule = reproduce.trend(0.5), source = src },
+    { item = "shrinks", paper = 1.8, measured = 0.9, rule = reproduce.trend(0.5), source = src },
+    { item = "claim, with a comma", paper = 1, measured = 0.5, rule = reproduce.below(), source = src },
+    { item = "claim broken", paper = 0, measured = -1, rule = reproduce.above(), source = src },
+    { item = "nan", paper = 1, measured = 0 / 0, rule = reproduce.within(0.1), source = src },
+    { item = "missing", paper = 1, rule = reproduce.below(), source = src },
+  }
+  local rep = reproduce.compare(rows, { out = dir, title = "T", quiet = true })
+  local want = { "matches within 10%", "differs (x1.5)", "matches within a factor 2", "trend matches",
+                 "trend matches within 50%", "trend differs", "claim holds", "differs", "not measured",
+                 "not measured" }
+  for i, v in ipairs(want) do assert(rep.rows[i].verdict == v, rows[i].item .. ": " .. rep.rows[i].verdict) end
+  assert(rep.failed == 5, "failed count " .. rep.failed)
+  assert(rep.rows[8].ratio ~= rep.rows[8].ratio, "a ratio to a paper value of 0 is undefined, not a number")
+  local csv = read_all(dir .. "/reproduction.csv")
+  assert(select(2, csv:gsub("\n", "")) == #rows + 1, "a header and one line per item")
+  assert(csv:find('"claim, with a comma"', 1, true), "fields with commas are quoted")
+  assert(csv:find("\nnan,,,1,nan,nan,", 1, true), "NaN kept as NaN: " .. csv)
+  assert(rep.html:find("<table", 1, true) and read_all(dir .. "/reproduction.md"):find("| equal |", 1, true))
+  expect_error(function() reproduce.compare({ { item = "x", paper = 0 / 0, measured = 1, rule = reproduce.below(),
+                                                source = src } }, { out = dir, title = "T", quiet = true }) end, "finite")
+  expect_error(function() reproduce.compare({ { item = "x", paper = 1, measured = 1, rule = reproduce.below() } },
+                                            { out = dir, title = "T", quiet = true }) end, "source")
+end)
+
 for _, t in ipairs(tests) do
   local ok, err = pcall(t.fn)
   if ok then print("ok   " .. t.name) else
