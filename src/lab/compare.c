@@ -69,11 +69,12 @@ uint64_t lab_config_key(const Lab *lab, const Technique *t, const double *params
 {
     Hasher h;
     hash_init(&h);
-    hash_str(&h, "shadowlab configuration 1");
+    hash_str(&h, "shadowlab configuration 2"); /* 2: parameters that do not act are left out */
     hash_u64(&h, lab_scene(lab)->hash);
     hash_u64(&h, (uint64_t)light_index);
     hash_str(&h, t->name);
     for (int i = 0; i < t->num_params; i++) {
+        if (!tech_param_acts(t, i, params)) continue; /* changes nothing: no row of its own */
         hash_str(&h, t->params[i].name);
         hash_f64(&h, params[i]);
     }

@@ -85,10 +85,11 @@ static bool sw_prepare(const TechContext *ctx, void **state, Error *err)
  * overflows and c_scale = 0 (I = 1) needs no special case. */
 static double attenuation(double sd, double sw, double c_scale, double c_bias)
 {
+    if (isnan(sd) || isnan(sw)) return NAN; /* a NaN depth or width: unknown, not lit */
     if (!(sd > 0.0)) return 1.0;
     double x = c_scale * sw;
     if (x >= (1.0 + c_bias) * sd) return 0.0;
-    return fmin(1.0, 1.0 + c_bias - x / sd);
+    return nan_min(1.0, 1.0 + c_bias - x / sd);
 }
 
 /* Shadow depth (world units) and width (texels) at the receiver. */

@@ -44,6 +44,8 @@ static const char *const lua_code =
     "assert(not ok and msg:find(\"unknown parameter 'nope'\", 1, true), msg)\n"
     "ok, msg = pcall(lab.compare, lab, { technique = 'hard', sample = 4 })\n"
     "assert(not ok and msg:find(\"unknown option 'sample'\", 1, true), msg)\n"
+    "ok, msg = pcall(sl.open, SCENE, { ['lights[1].radius'] = 0/0 })\n"
+    "assert(not ok and msg:find('lights[1].radius', 1, true) and msg:find('is NaN', 1, true), msg)\n"
     "local ref = lab:reference{ samples = 8, cache = false }\n"
     "local img = ref:image('reference')\n"
     "lab:close()\n"
