@@ -153,7 +153,7 @@ static bool set_value(const Technique *t, int i, double v, double *values, Error
 bool tech_param_set(const Technique *t, const char *name, double v, double *values, Error *err)
 {
     int i = tech_param_index(t, name);
-    if (i >= 0 && !condition_possible(t, i))
+    if (i >= 0 && !condition_possible(t, i) && v != t->params[i].def) /* its default: what leaving it out means */
         return error_set(err, "%s: parameter '%s' is not one of its own: it acts only when %s, which %s does not take",
                          t->name, name, tech_param_when(t, i), t->name);
     if (i < 0) {
@@ -201,7 +201,7 @@ bool tech_param_parse(const Technique *t, const char *assignment, double *values
     char name[128];
     snprintf(name, sizeof name, "%.*s", (int)(eq - assignment), assignment);
     int i = tech_param_index(t, name);
-    if (i < 0 || !condition_possible(t, i)) return tech_param_set(t, name, 0, values, err); /* reports the name */
+    if (i < 0) return tech_param_set(t, name, 0, values, err); /* reports the unknown name */
     double v;
     if (!parse_value(&t->params[i], eq + 1, &v)) return refuse(t, &t->params[i], eq + 1, err);
     return tech_param_set(t, name, v, values, err);

@@ -41,8 +41,10 @@ bool tech_param_acts(const Technique *t, int k, const double *values);
 /* Can parameter k's condition hold at all within the technique's ranges (a
  * shared map parameter that acts only under warps, in a technique that takes
  * no warps, cannot), and does its range hold two values? One that cannot or
- * does not is not the technique's: parsing refuses
- * it by name, `list` and the docs leave it out. */
+ * does not is not the technique's: `list`, the docs and the Lua
+ * descriptions leave it out, and setting it to anything but its default is
+ * refused by name (its default is accepted: records and round trips name
+ * every parameter). */
 bool tech_param_offered(const Technique *t, int k);
 /* Set the parameters that parameter k's condition names so that its first
  * possible alternative holds (the registry-wide parameter test varies k there). */

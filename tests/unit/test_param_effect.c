@@ -106,28 +106,66 @@ static bool render(Lab *lab, const Technique *t, const double *v, RenderResult *
     return lab_render(lab, &rq, out, &err);
 }
 
+/* The render at the plain base (defaults, small map), once per technique
+ * and lab: most parameters are tried from it. */
+typedef struct BaseRender {
+    const Technique *t;
+    Lab *lab;
+    bool ok;
+    RenderResult r;
+} BaseRender;
+#define EFFECT_MAX_BASES 128
+static BaseRender bases[EFFECT_MAX_BASES];
+static int num_bases;
+
+static const RenderResult *base_render(Lab *lab, const Technique *t, const double *v)
+{
+    for (int i = 0; i < num_bases; i++)
+        if (bases[i].t == t && bases[i].lab == lab) return bases[i].ok ? &bases[i].r : NULL;
+    if (num_bases == EFFECT_MAX_BASES) return NULL;
+    BaseRender *b = &bases[num_bases++];
+    *b = (BaseRender){.t = t, .lab = lab};
+    b->ok = render(lab, t, v, &b->r);
+    return b->ok ? &b->r : NULL;
+}
+
+static void free_bases(void)
+{
+    for (int i = 0; i < num_bases; i++)
+        if (bases[i].ok) render_result_free(&bases[i].r);
+    num_bases = 0;
+}
+
 /* Do two values of parameter k that render give different outputs on this lab? */
 static bool acts_on(Lab *lab, const Technique *t, int k, const char *settings)
 {
-    double base[TECH_MAX_PARAMS], values[EFFECT_MAX_TRIES + 1];
+    double base[TECH_MAX_PARAMS], plain[TECH_MAX_PARAMS], values[EFFECT_MAX_TRIES + 1];
     if (!base_values(t, k, settings, base)) return false;
+    tech_params_default(t, plain);
+    if (smap_has_map_params(t)) plain[SMAP_P_MAP_SIZE] = EFFECT_MAP_SIZE;
+    bool is_plain = memcmp(base, plain, sizeof(double) * (size_t)t->num_params) == 0;
     int n = try_values(&t->params[k], base[k], values);
-    RenderResult first;
-    bool have_first = false, differs = false;
+    RenderResult own;
+    const RenderResult *first = NULL;
+    bool differs = false;
     for (int i = 0; i < n && !differs; i++) {
         double v[TECH_MAX_PARAMS];
         memcpy(v, base, sizeof v);
         v[k] = values[i];
-        RenderResult r;
-        if (!render(lab, t, v, have_first ? &r : &first)) continue; /* a value the technique refuses */
-        if (!have_first) {
-            have_first = true;
+        if (!first && i == 0 && is_plain) {
+            first = base_render(lab, t, v);
             continue;
         }
-        differs = !same_output(&first, &r);
+        RenderResult r;
+        if (!render(lab, t, v, first ? &r : &own)) continue; /* a value the technique refuses */
+        if (!first) {
+            first = &own;
+            continue;
+        }
+        differs = !same_output(first, &r);
         render_result_free(&r);
     }
-    if (have_first) render_result_free(&first);
+    if (first == &own) render_result_free(&own);
     return differs;
 }
 
@@ -190,6 +228,7 @@ TEST(test_param_effect_every_parameter_changes_an_output)
             }
         }
     }
+    free_bases();
     for (int i = 0; i < EFFECT_NUM_SCENES; i++) lab_close(labs[i]);
     printf("    %d parameters of %d techniques checked\n", checked, tech_count());
     CHECK_MSG(idle == 0, "%d of %d parameters changed no output on any scene", idle, checked);

@@ -95,4 +95,5 @@ TEST(test_registry_conditions_are_well_formed)
     CHECK(!tech_param_offered(aa, tech_param_index(aa, "warp_n")));
     CHECK(!tech_param_parse(aa, "warp_n=2", v, &err));
     CHECK_MSG(strstr(err.msg, "warp_n") && strstr(err.msg, "projection=lispsm"), "%s", err.msg);
+    CHECK_MSG(tech_param_parse(aa, "warp_n=1", v, &err), "its default, as a record names it: %s", err.msg);
 }
