@@ -153,9 +153,12 @@ static bool set_value(const Technique *t, int i, double v, double *values, Error
 bool tech_param_set(const Technique *t, const char *name, double v, double *values, Error *err)
 {
     int i = tech_param_index(t, name);
-    if (i >= 0 && !condition_possible(t, i) && v != t->params[i].def) /* its default: what leaving it out means */
+    if (i >= 0 && !condition_possible(t, i) && v != t->params[i].def) { /* its default: what leaving it out means */
+        double scratch[TECH_MAX_PARAMS];
+        if (!set_value(t, i, v, scratch, err)) return false; /* an ill-typed value: refused with the range */
         return error_set(err, "%s: parameter '%s' is not one of its own: it acts only when %s, which %s does not take",
                          t->name, name, tech_param_when(t, i), t->name);
+    }
     if (i < 0) {
         char known[512] = "";
         size_t used = 0;
