@@ -153,12 +153,6 @@ static bool set_value(const Technique *t, int i, double v, double *values, Error
 bool tech_param_set(const Technique *t, const char *name, double v, double *values, Error *err)
 {
     int i = tech_param_index(t, name);
-    if (i >= 0 && !condition_possible(t, i) && v != t->params[i].def) { /* its default: what leaving it out means */
-        double scratch[TECH_MAX_PARAMS];
-        if (!set_value(t, i, v, scratch, err)) return false; /* an ill-typed value: refused with the range */
-        return error_set(err, "%s: parameter '%s' is not one of its own: it acts only when %s, which %s does not take",
-                         t->name, name, tech_param_when(t, i), t->name);
-    }
     if (i < 0) {
         char known[512] = "";
         size_t used = 0;
@@ -168,6 +162,11 @@ bool tech_param_set(const Technique *t, const char *name, double v, double *valu
         return error_set(err, "%s: unknown parameter '%s' (parameters: %s)", t->name, name,
                          t->num_params ? known : "none");
     }
+    double scratch[TECH_MAX_PARAMS];
+    if (!condition_possible(t, i) && v != t->params[i].def) /* its default: what leaving it out means */
+        return set_value(t, i, v, scratch, err) && /* an ill-typed value: refused with the range */
+               error_set(err, "%s: parameter '%s' is not one of its own: it acts only when %s, which %s does not take",
+                         t->name, name, tech_param_when(t, i), t->name);
     return set_value(t, i, v, values, err);
 }
 
