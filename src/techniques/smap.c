@@ -15,7 +15,11 @@ const char *const smap_select_names[] = {CASCADE_SELECT_NAMES, NULL};
  * resources/warp.c's warp_n, lightview.c's fit_face): a warp's n and falloff
  * (lispsm, logpsm; tsm's falloff), a free n, TSM's focus, the splits of a
  * partitioned map (cascades, or the frustum's faces), stable extents
- * (unwarped single faces). A technique that takes none of the listed
+ * (unwarped faces: ortho and perspective maps, also per cascade, and the
+ * flat near and far faces of a face partition, lightview.c's
+ * fit_face_partition). A condition may be wider than where the parameter
+ * acts (stabilize with an auto projection that resolves to a cube), never
+ * narrower: the configuration key leaves out what it excludes. A technique that takes none of the listed
  * values (adaptive_area: no warps) is not offered the parameter. */
 #define SMAP_WARPED "projection=psm|lispsm|tsm|logpsm"
 #define SMAP_PARTED "cascades!=1 or split_scheme=faces"
@@ -25,7 +29,7 @@ const ParamCondition smap_conditions[] = {
     {"warp_falloff", "projection=lispsm|logpsm and warp_n_world=0 or projection=tsm"},
     {"pseudo_near", SMAP_WARPED " or " SMAP_PARTED},
     {"tsm_focus", "projection=tsm"},
-    {"stabilize", "projection=auto|perspective|ortho and split_scheme!=faces"},
+    {"stabilize", "projection=auto|perspective|ortho or split_scheme=faces"}, /* faces: near and far are flat */
     {"split_scheme", SMAP_PARTED},
     {"split_lambda", "split_scheme=practical and cascades!=1"},
     {"split_1", "split_scheme=explicit and cascades=2|3|4"},
