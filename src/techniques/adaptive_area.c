@@ -50,6 +50,14 @@ static const ParamDesc aa_params[] = {
      NULL},
 };
 
+/* Subdivision stops at max_level; fixed splits every region, thresholds unread. */
+static const ParamCondition aa_conditions[] = {
+    {"threshold", "fixed=false and max_level!=0"},
+    {"color_threshold", "fixed=false and max_level!=0"},
+    {"fixed", "max_level!=0"},
+    {NULL, NULL},
+};
+
 static const char *const aa_resources[] = {"shadow_map", "minmax_pyramid", "light_image_sat", "view_samples", NULL};
 /* level: the deepest subdivision reached (Table 2, Fig. 2); tests: the
  * shadow-map tests the sample took (search and regions), the work that
@@ -336,6 +344,7 @@ const Technique tech_adaptive_area = {
     .rgb = true,
     .lights = LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_TEXTURED_RECT),
     .main_param = "threshold",
+    .conditions = aa_conditions,
     .prepare = aa_prepare,
     .evaluate = aa_evaluate,
     .release = free,

@@ -46,6 +46,9 @@ static const ParamDesc sw_params[] = {
      filter_names},
 };
 
+/* c_bias offsets 1 - c_scale sw / sd, which c_scale = 0 makes 1 everywhere. */
+static const ParamCondition sw_conditions[] = {{"c_bias", "c_scale!=0"}, {NULL, NULL}};
+
 static const char *const sw_resources[] = {"shadow_map", "shadow_width_map", "view_samples", NULL};
 static const char *const sw_aux[] = {"shadow_width", "shadow_depth", NULL};
 
@@ -149,6 +152,7 @@ const Technique tech_shadow_width = {
     .rgb = false,
     .lights = LIGHTS_ALL,
     .main_param = "c_scale",
+    .conditions = sw_conditions,
     .prepare = sw_prepare,
     .evaluate = sw_evaluate,
     .release = free,

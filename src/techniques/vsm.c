@@ -217,21 +217,24 @@ static void moment_evaluate(const void *state, const TechContext *ctx, int begin
     }
 }
 
-#define MOMENT_TECHNIQUE(var, tname, tsource, tsummary, table, prep, tmain)                                        \
+#define MOMENT_TECHNIQUE(var, tname, tsource, tsummary, table, prep, tmain, tconditions)                           \
     const Technique var = {.name = tname, .family = "filtered", .source = tsource, .summary = tsummary,           \
                            .params = table, .num_params = (int)(sizeof table / sizeof table[0]),                \
                            .resources = filter_resources, .rgb = false, .lights = LIGHTS_ALL, .main_param = tmain, \
-                           .prepare = prep, .evaluate = moment_evaluate, .release = free}
+                           .conditions = tconditions, .prepare = prep, .evaluate = moment_evaluate, .release = free}
+
+/* The negative warp exists only with both warps. */
+static const ParamCondition evsm_conditions[] = {{"exponent_neg", "warps=both"}, {NULL, NULL}};
 
 MOMENT_TECHNIQUE(tech_vsm, "vsm", "course §4.2.1 (Eq. 4.2; Donnelly & Lauritzen 2006), §4.2.2 bleeding reduction",
                  "variance shadow map: Chebyshev's upper bound from the prefiltered z and z^2", vsm_params,
-                 vsm_prepare, "K");
+                 vsm_prepare, "K", NULL);
 MOMENT_TECHNIQUE(tech_lvsm, "lvsm", "course §4.2.2 (Lauritzen & McCool 2008)",
                  "layered variance shadow map: the Chebyshev bound within the receiver's depth layer", lvsm_params,
-                 lvsm_prepare, "layers");
+                 lvsm_prepare, "layers", NULL);
 MOMENT_TECHNIQUE(tech_evsm, "evsm", "course §4.2.4 'EVSM' (Lauritzen & McCool 2008; warp pair erratum)",
                  "exponential variance shadow map: Chebyshev on exp(c+ z) and -exp(-c- z), the smaller bound",
-                 evsm_params, evsm_prepare, "K");
+                 evsm_params, evsm_prepare, "K", evsm_conditions);
 MOMENT_TECHNIQUE(tech_msm, "msm", "Peters & Klein 2015, Algorithm 2 (Hamburger 4MSM); not in the course",
                  "moment shadow map: the sharpest lower bound on the shadow from four prefiltered moments",
-                 msm_params, msm_prepare, "K");
+                 msm_params, msm_prepare, "K", NULL);
