@@ -45,13 +45,14 @@ static const struct { const char *param, *settings; } probes[] = {
     {"cascade_blend", "cascades=8"},
 };
 
-/* The test's base values: the defaults, a small map, k's condition, then
- * the settings ("name=value ..."; NULL: none); false if one does not apply. */
-static bool base_values(const Technique *t, int k, const char *settings, double *v)
+/* The test's base values: the defaults, a small map, k's condition (when
+ * `enable`), then the settings ("name=value ..."; NULL: none); false if
+ * one does not apply. */
+static bool base_values(const Technique *t, int k, bool enable, const char *settings, double *v)
 {
     tech_params_default(t, v);
     if (smap_has_map_params(t)) v[SMAP_P_MAP_SIZE] = EFFECT_MAP_SIZE;
-    tech_param_enable(t, k, v);
+    if (enable) tech_param_enable(t, k, v);
     char buf[256], *save = NULL;
     Error err;
     snprintf(buf, sizeof buf, "%s", settings ? settings : "");
@@ -87,13 +88,21 @@ static bool same_image(const Image *a, const Image *b)
     return na == nb && (na == 0 || memcmp(a->data, b->data, na * sizeof *a->data) == 0);
 }
 
-/* The resource kinds a render acquired, in order (a box blur or a SAT, a
- * min-max pyramid or an N-buffer: what the record lists). */
+static int kind_count(const RenderResult *r, const char *kind)
+{
+    int n = 0;
+    for (int i = 0; i < r->num_tech_resources; i++) n += strcmp(r->tech_resources[i].kind, kind) == 0;
+    return n;
+}
+
+/* The resource kinds a render acquired, as a multiset (a box blur or a SAT,
+ * a min-max pyramid or an N-buffer: what the record lists; a reused
+ * resource lists its dependencies in another order than a built one). */
 static bool same_resources(const RenderResult *a, const RenderResult *b)
 {
     if (a->num_tech_resources != b->num_tech_resources) return false;
     for (int i = 0; i < a->num_tech_resources; i++)
-        if (strcmp(a->tech_resources[i].kind, b->tech_resources[i].kind) != 0) return false;
+        if (kind_count(a, a->tech_resources[i].kind) != kind_count(b, a->tech_resources[i].kind)) return false;
     return true;
 }
 
@@ -139,11 +148,12 @@ static void free_bases(void)
     num_bases = 0;
 }
 
-/* Do two values of parameter k that render give different outputs on this lab? */
-static bool acts_on(Lab *lab, const Technique *t, int k, const char *settings)
+/* Do two values of parameter k that render give different outputs on this
+ * lab? With `enable` false, only values under which k's condition fails. */
+static bool acts_on(Lab *lab, const Technique *t, int k, bool enable, const char *settings)
 {
     double base[TECH_MAX_PARAMS], plain[TECH_MAX_PARAMS], values[EFFECT_MAX_TRIES + 1];
-    if (!base_values(t, k, settings, base)) return false;
+    if (!base_values(t, k, enable, settings, base)) return false;
     tech_params_default(t, plain);
     if (smap_has_map_params(t)) plain[SMAP_P_MAP_SIZE] = EFFECT_MAP_SIZE;
     bool is_plain = memcmp(base, plain, sizeof(double) * (size_t)t->num_params) == 0;
@@ -155,6 +165,7 @@ static bool acts_on(Lab *lab, const Technique *t, int k, const char *settings)
         double v[TECH_MAX_PARAMS];
         memcpy(v, base, sizeof v);
         v[k] = values[i];
+        if (!enable && tech_param_acts(t, k, v)) continue; /* a value that meets its own condition (split_scheme=faces) */
         if (!first && i == 0 && is_plain) {
             first = base_render(lab, t, v);
             continue;
@@ -195,9 +206,9 @@ static bool known(const Technique *t, int k)
 /* Does parameter k act on this lab, at the base or under one of its probes? */
 static bool acts_probed(Lab *lab, const Technique *t, int k)
 {
-    if (acts_on(lab, t, k, NULL)) return true;
+    if (acts_on(lab, t, k, true, NULL)) return true;
     for (size_t i = 0; i < sizeof probes / sizeof probes[0]; i++)
-        if (strcmp(probes[i].param, t->params[k].name) == 0 && acts_on(lab, t, k, probes[i].settings)) return true;
+        if (strcmp(probes[i].param, t->params[k].name) == 0 && acts_on(lab, t, k, true, probes[i].settings)) return true;
     return false;
 }
 
@@ -239,6 +250,38 @@ TEST(test_param_effect_every_parameter_changes_an_output)
     omp_set_num_threads(threads);
     printf("    %d parameters of %d techniques checked\n", checked, tech_count());
     CHECK_MSG(idle == 0, "%d of %d parameters changed no output on any scene", idle, checked);
+}
+
+/* The converse, which the configuration key relies on: where its condition
+ * does not hold (at the defaults), a parameter changes no output on any of
+ * the scenes, so a condition is never narrower than where it acts. */
+TEST(test_param_effect_outside_its_condition_a_parameter_changes_nothing)
+{
+    int threads = omp_get_max_threads(), wrong = 0, checked = 0;
+    omp_set_num_threads(1);
+    for (int s = 0; s < EFFECT_NUM_SCENES; s++) {
+        Lab *lab = filtered_open(effect_scenes[s], EFFECT_W, EFFECT_H);
+        for (int ti = 0; lab && ti < tech_count(); ti++) {
+            const Technique *t = tech_at(ti);
+            if (!(t->lights & LIGHT_BIT(lab_scene(lab)->lights[0].kind))) continue;
+            double v[TECH_MAX_PARAMS];
+            base_values(t, 0, false, NULL, v);
+            for (int k = 0; k < t->num_params; k++) {
+                if (!tech_param_offered(t, k) || tech_param_acts(t, k, v)) continue;
+                checked++;
+                if (acts_on(lab, t, k, false, NULL)) {
+                    wrong++;
+                    printf("    acts outside its condition: %s.%s (when %s) on %s\n", t->name, t->params[k].name,
+                           tech_param_when(t, k), effect_scenes[s]);
+                }
+            }
+        }
+        free_bases();
+        if (lab) lab_close(lab);
+    }
+    omp_set_num_threads(threads);
+    printf("    %d (technique, parameter, scene) triples outside their condition checked\n", checked);
+    CHECK_MSG(wrong == 0, "%d parameters change outputs where their condition says they do not act", wrong);
 }
 
 /* The configuration key leaves out a parameter whose condition does not
