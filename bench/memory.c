@@ -60,7 +60,8 @@ static Usage child_run(const Options *o, const Technique *t, int res)
         return u;
     }
     params[size] = res;
-    if (proj >= 0) params[proj] = MAP_PROJ_PERSPECTIVE; /* one face: a sphere light's default may be a six-face cube */
+    if (proj >= 0 && t->params[proj].max >= MAP_PROJ_PERSPECTIVE) /* one face: a sphere light's default may be a cube */
+        params[proj] = MAP_PROJ_PERSPECTIVE;
     Lab *lab = bench_lab_open(o->scene, t, NULL, 0, &u.light, &err);
     RenderRequest req = {.tech = t, .params = params, .light_index = 0, .repeat = 1};
     RenderResult r;

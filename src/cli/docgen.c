@@ -19,7 +19,9 @@ static void cell(FILE *fp, const char *text)
     fputs(" |", fp);
 }
 
-static void param_row(FILE *fp, const ParamDesc *p, const char *note)
+/* One parameter's row; `when` (its condition, NULL: none) and `note` (how
+ * techniques differ, "" or NULL: none) follow its doc. */
+static void param_row(FILE *fp, const ParamDesc *p, const char *when, const char *note)
 {
     char def[64], range[256], name[80];
     tech_param_format(p, p->def, def, sizeof def);
@@ -31,13 +33,11 @@ static void param_row(FILE *fp, const ParamDesc *p, const char *note)
     cell(fp, def);
     cell(fp, range);
     cell(fp, p->unit);
-    if (note && note[0]) {
-        char doc[2048];
-        snprintf(doc, sizeof doc, "%s. %s", p->doc, note);
-        cell(fp, doc);
-    } else {
-        cell(fp, p->doc);
-    }
+    char doc[2048];
+    size_t used = (size_t)snprintf(doc, sizeof doc, "%s", p->doc);
+    if (when && used < sizeof doc) used += (size_t)snprintf(doc + used, sizeof doc - used, ". Acts only when %s", when);
+    if (note && note[0] && used < sizeof doc) snprintf(doc + used, sizeof doc - used, ". %s", note);
+    cell(fp, doc);
     fputs("\n", fp);
 }
 
@@ -58,7 +58,8 @@ void docgen_techniques_md(FILE *fp)
                 t->rgb ? "visibility, RGB for textured lights" : "visibility");
         for (const char *const *r = t->resources; *r; r++) fprintf(fp, " `%s`", *r);
         fprintf(fp, "\n\n%s", param_header);
-        for (int k = 0; k < t->num_params; k++) param_row(fp, &t->params[k], NULL);
+        for (int k = 0; k < t->num_params; k++)
+            if (tech_param_offered(t, k)) param_row(fp, &t->params[k], tech_param_when(t, k), NULL);
     }
 }
 
@@ -82,9 +83,14 @@ static void technique_table(FILE *fp)
 }
 
 /* How technique t's parameter k differs from the base's ("" when it does not). */
-static void difference(const ParamDesc *base, const ParamDesc *p, char *out, size_t n)
+static void difference(const Technique *base_t, const Technique *t, int k, char *out, size_t n)
 {
+    const ParamDesc *base = &base_t->params[k], *p = &t->params[k];
     char def[64], range[256];
+    if (!tech_param_offered(t, k)) {
+        snprintf(out, n, "not taken");
+        return;
+    }
     tech_param_format(p, p->def, def, sizeof def);
     tech_param_range(p, range, sizeof range);
     bool other_def = p->def != base->def, other_range = p->min != base->min || p->max != base->max;
@@ -102,11 +108,11 @@ static void differences(const Technique *const *maps, int n, int k, char *out, s
     bool listed[64] = {false};
     for (int i = 1; i < n && used < size; i++) {
         char what[320], other[320];
-        difference(&maps[0]->params[k], &maps[i]->params[k], what, sizeof what);
+        difference(maps[0], maps[i], k, what, sizeof what);
         if (!what[0] || listed[i]) continue;
         used += (size_t)snprintf(out + used, size - used, "%s%s in `%s`", used ? "; " : "", what, maps[i]->name);
         for (int j = i + 1; j < n && used < size; j++) {
-            difference(&maps[0]->params[k], &maps[j]->params[k], other, sizeof other);
+            difference(maps[0], maps[j], k, other, sizeof other);
             if (strcmp(other, what) != 0) continue;
             listed[j] = true;
             used += (size_t)snprintf(out + used, size - used, ", `%s`", maps[j]->name);
@@ -143,7 +149,7 @@ static void shared_map_params(FILE *fp)
     for (int k = 0; k < shared_count(maps, n); k++) {
         char note[1024];
         differences(maps, n, k, note, sizeof note);
-        param_row(fp, &maps[0]->params[k], note);
+        param_row(fp, &maps[0]->params[k], tech_param_when(maps[0], k), note);
     }
 }
 

@@ -1,5 +1,6 @@
 /* list.c -- `shadowlab list`: every technique in the registry with its
- * parameters (type, default, range, unit, doc), as text or JSON, or the
+ * parameters (type, default, range, unit, doc, the condition under which
+ * it acts), as text or JSON, or the
  * generated documents (docgen.h). */
 #include "cli/cli.h"
 #include "cli/docgen.h"
@@ -18,11 +19,14 @@ static void print_text(void)
         printf("\n");
         for (int k = 0; k < t->num_params; k++) {
             const ParamDesc *p = &t->params[k];
+            const char *when = tech_param_when(t, k);
             char def[64], range[256];
+            if (!tech_param_offered(t, k)) continue;
             tech_param_format(p, p->def, def, sizeof def);
             tech_param_range(p, range, sizeof range);
             printf("  -p %s=%s  (%s %s%s%s)\n      %s\n", p->name, def, param_type_name(p->type), range,
                    p->unit[0] ? ", " : "", p->unit, p->doc);
+            if (when) printf("      acts only when %s\n", when);
         }
         printf("\n");
     }
@@ -52,6 +56,7 @@ static void print_json(void)
         json_array_begin(&w, "params");
         for (int k = 0; k < t->num_params; k++) {
             const ParamDesc *p = &t->params[k];
+            if (!tech_param_offered(t, k)) continue;
             json_object_begin(&w, NULL);
             json_string(&w, "name", p->name);
             json_string(&w, "type", param_type_name(p->type));
@@ -60,6 +65,7 @@ static void print_json(void)
             json_number(&w, "max", p->max);
             json_string(&w, "unit", p->unit);
             json_string(&w, "doc", p->doc);
+            if (tech_param_when(t, k)) json_string(&w, "acts_when", tech_param_when(t, k)); /* absent: always */
             if (p->type == PARAM_ENUM) {
                 json_array_begin(&w, "choices");
                 for (int c = 0; p->choices[c]; c++) json_string(&w, NULL, p->choices[c]);

@@ -70,11 +70,12 @@ uint64_t lab_config_key(const Lab *lab, const Technique *t, const double *params
 {
     Hasher h;
     hash_init(&h);
-    hash_str(&h, "shadowlab configuration 2");
+    hash_str(&h, "shadowlab configuration 2"); /* 2: enums by name; parameters that do not act left out */
     hash_u64(&h, lab_scene(lab)->hash);
     hash_u64(&h, (uint64_t)light_index);
     hash_str(&h, t->name);
     for (int i = 0; i < t->num_params; i++) {
+        if (!tech_param_acts(t, i, params)) continue; /* changes nothing: no row of its own */
         const ParamDesc *p = &t->params[i];
         hash_str(&h, p->name);
         /* An enum by its choice's name, not its index: reordering or inserting

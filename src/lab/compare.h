@@ -42,7 +42,9 @@ void compare_result_free(CompareResult *r);
 RunReport compare_report(Lab *lab, const CompareResult *r, const char *command, int threads);
 
 /* Stable key of a configuration: a hash of the scene's content hash, the
- * light, the technique's name and every parameter (name and value). */
+ * light, the technique's name and every parameter that acts under the
+ * others (name and value; tech_param_acts), so a sweep over a parameter
+ * outside its condition records one row, not duplicates. */
 uint64_t lab_config_key(const Lab *lab, const Technique *t, const double *params, int light_index);
 
 #endif

@@ -250,6 +250,7 @@ static void plan_param_probes(Runner *rn, const Technique *t)
     if (!first_of(any_order, 7, t->lights, &kind)) return;
     for (int i = 0; i < t->num_params; i++) {
         char name[STAB_NAME_MAX];
+        if (!tech_param_offered(t, i)) continue; /* not the technique's (registry.h): nothing to probe */
         snprintf(name, sizeof name, "param_%s", t->params[i].name);
         if (rn->st.quick && wanted(rn, name)) {
             add_job(rn, t, NULL, i, PROBE_ALL, kind, name);

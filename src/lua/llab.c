@@ -89,16 +89,21 @@ static void append_double(char *out, size_t n, size_t *used, double v)
     append(out, n, used, "%s", text);
 }
 
-/* Append an override value as the Lua expression the scene sandbox
- * evaluates: numbers, booleans, quoted strings, arrays of these. */
-static void override_text(lua_State *L, int idx, char *out, size_t n, size_t *used)
+/* Append override `key`'s value as the Lua expression the scene sandbox
+ * evaluates: numbers, booleans, quoted strings, arrays of these. A NaN or
+ * infinite number has no such text (%g writes "nan", read back as a
+ * string): it is refused here, by name. */
+static void override_text(lua_State *L, const char *key, int idx, char *out, size_t n, size_t *used)
 {
     idx = lua_absindex(L, idx);
     switch (lua_type(L, idx)) {
-    case LUA_TNUMBER:
+    case LUA_TNUMBER: {
+        double v = lua_tonumber(L, idx);
         if (lua_isinteger(L, idx)) append(out, n, used, "%lld", (long long)lua_tointeger(L, idx));
-        else append_double(out, n, used, lua_tonumber(L, idx));
+        else if (isfinite(v)) append_double(out, n, used, v);
+        else luaL_error(L, "scene override '%s' is %s, expected a finite number", key, isnan(v) ? "NaN" : "infinite");
         break;
+    }
     case LUA_TBOOLEAN: append(out, n, used, "%s", lua_toboolean(L, idx) ? "true" : "false"); break;
     case LUA_TSTRING:
         append(out, n, used, "\"");
@@ -110,7 +115,7 @@ static void override_text(lua_State *L, int idx, char *out, size_t n, size_t *us
         append(out, n, used, "{");
         for (lua_Integer i = 1, len = (lua_Integer)lua_rawlen(L, idx); i <= len; i++) {
             lua_rawgeti(L, idx, i);
-            override_text(L, -1, out, n, used);
+            override_text(L, key, -1, out, n, used);
             lua_pop(L, 1);
             append(out, n, used, "%s", i < len ? "," : "");
         }
@@ -136,7 +141,7 @@ static int collect_overrides(lua_State *L, int idx, const char **out, int max)
         char text[1001];
         size_t used = (size_t)snprintf(text, sizeof text, "%s=", lua_tostring(L, -2));
         if (used >= sizeof text) luaL_error(L, "scene override key too long");
-        override_text(L, -1, text, sizeof text, &used);
+        override_text(L, lua_tostring(L, -2), -1, text, sizeof text, &used);
         if (used >= sizeof text) luaL_error(L, "scene override '%s' longer than %d characters", lua_tostring(L, -2),
                                             (int)sizeof text - 1);
         lua_pushstring(L, text);

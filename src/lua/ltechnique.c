@@ -80,9 +80,14 @@ void sl_push_technique(lua_State *L, const Technique *t)
     push_string_list(L, t->resources);
     lua_setfield(L, -2, "resources");
     lua_createtable(L, t->num_params, 0);
-    for (int i = 0; i < t->num_params; i++) {
+    for (int i = 0, n = 0; i < t->num_params; i++) {
+        if (!tech_param_offered(t, i)) continue; /* not the technique's (registry.h) */
         push_param(L, &t->params[i]);
-        lua_rawseti(L, -2, i + 1);
+        if (tech_param_when(t, i)) {
+            lua_pushstring(L, tech_param_when(t, i));
+            lua_setfield(L, -2, "acts_when"); /* nil: always */
+        }
+        lua_rawseti(L, -2, ++n);
     }
     lua_setfield(L, -2, "params");
 }

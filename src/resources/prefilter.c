@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include "core/hash.h"
+#include "core/nanmath.h"
 
 /* ---- element storage ---- */
 
@@ -63,7 +64,8 @@ int moment_channels(const MomentSpec *sp)
 
 double prefilter_depth_unit(const ShadowMap *m, int face, double z)
 {
-    if (!(z < INFINITY)) return 1.0; /* no caster: the far plane */
+    if (isnan(z)) return z;          /* an unknown depth stays unknown */
+    if (z == INFINITY) return 1.0; /* no caster: the far plane */
     double u = z;
     if (m->spec.depth == RASTER_DEPTH_LINEAR) {
         const RasterView *rv = &m->view.face[face].raster;
@@ -623,8 +625,8 @@ static void *build_pyramid(const void *args, Error *err)
                     for (int b = 0; b < 2; b++)
                         for (int c = 0; c < 2; c++) {
                             const float *q = node(p, l - 1, f, clampi(2 * i + c, 0, below - 1), clampi(2 * j + b, 0, below - 1));
-                            lo = fminf(lo, q[0]);
-                            hi = fmaxf(hi, q[1]);
+                            lo = nan_minf(lo, q[0]); /* a NaN texel: the node's bounds are unknown */
+                            hi = nan_maxf(hi, q[1]);
                         }
                     float *q = node(p, l, f, i, j);
                     q[0] = lo;
@@ -659,8 +661,8 @@ void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int 
     for (int j = j0 >> l; j <= j1 >> l; j++)
         for (int i = i0 >> l; i <= i1 >> l; i++) {
             const float *q = node(p, l, face, i, j);
-            lo = fminf(lo, q[0]);
-            hi = fmaxf(hi, q[1]);
+            lo = nan_minf(lo, q[0]);
+            hi = nan_maxf(hi, q[1]);
         }
     *zmin = lo;
     *zmax = hi;
@@ -724,8 +726,8 @@ static void buffer_double(float *mm, int res, int faces, int half)
         float *row = mm + 2 * (size_t)r * res;
         for (int i = 0; i < res; i++) {
             const float *q = row + 2 * (size_t)clampi(i + half, 0, res - 1);
-            row[2 * i] = fminf(row[2 * i], q[0]);
-            row[2 * i + 1] = fmaxf(row[2 * i + 1], q[1]);
+            row[2 * i] = nan_minf(row[2 * i], q[0]);
+            row[2 * i + 1] = nan_maxf(row[2 * i + 1], q[1]);
         }
     }
 #pragma omp parallel for schedule(static)
@@ -736,8 +738,8 @@ static void buffer_double(float *mm, int res, int faces, int half)
             float *row = face + 2 * (size_t)j * res;
             const float *ahead = face + 2 * (size_t)clampi(j + half, 0, res - 1) * res;
             for (int i = i0; i < i1; i++) {
-                row[2 * i] = fminf(row[2 * i], ahead[2 * i]);
-                row[2 * i + 1] = fmaxf(row[2 * i + 1], ahead[2 * i + 1]);
+                row[2 * i] = nan_minf(row[2 * i], ahead[2 * i]);
+                row[2 * i + 1] = nan_maxf(row[2 * i + 1], ahead[2 * i + 1]);
             }
         }
     }
@@ -797,8 +799,8 @@ void minmax_buffer_query(const MinMaxBuffer *b, int face, int i0, int j0, int i1
     for (int y = 0; y < ny; y++)
         for (int x = 0; x < nx; x++) {
             const float *q = b->minmax + 2 * (((size_t)face * b->res + ys[y]) * b->res + xs[x]);
-            lo = fminf(lo, q[0]);
-            hi = fmaxf(hi, q[1]);
+            lo = nan_minf(lo, q[0]);
+            hi = nan_maxf(hi, q[1]);
         }
     *zmin = lo;
     *zmax = hi;

@@ -26,9 +26,11 @@ enum { P_THRESHOLD = SMAP_NUM_PARAMS, P_MAX_LEVEL, P_COLOR_THRESHOLD, P_FIXED, P
 /* Cuts of the search cone at the nearest possible blocker (search_depth). */
 #define AA_SEARCH_REFINEMENTS 3
 
-/* Plain perspective maps along the light's normal (light_axes): no warps or face splits. */
+/* Plain perspective maps along the light's normal (light_axes): no warps or
+ * face splits; auto is perspective for its rect lights, so projection has
+ * the one value auto and is not offered (registry.h). */
 static const ParamDesc aa_params[] = {
-    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_PERSPECTIVE, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT),
+    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_AUTO, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT),
     SMAP_BIAS_PARAMS_PLANE(1),
     {"threshold", PARAM_FLOAT, 0.2244, 0, 0.25, "",
      "visibility variance E - E^2 above which a region splits into 4 (seed 001 §3: 0.2244; Fig. 2: 0.10, 0.22, 0.24)",
@@ -46,6 +48,14 @@ static const ParamDesc aa_params[] = {
     {"search_taps", PARAM_INT, 8, 1, AA_MAX_SEARCH_TAPS, "taps per side",
      "blocker-search tests: search_taps x search_taps points over the cone's region at the nearest possible blocker",
      NULL},
+};
+
+/* Subdivision stops at max_level; fixed splits every region, thresholds unread. */
+static const ParamCondition aa_conditions[] = {
+    {"threshold", "fixed=false and max_level!=0"},
+    {"color_threshold", "fixed=false and max_level!=0"},
+    {"fixed", "max_level!=0"},
+    {NULL, NULL},
 };
 
 static const char *const aa_resources[] = {"shadow_map", "minmax_pyramid", "light_image_sat", "view_samples", NULL};
@@ -193,6 +203,7 @@ static double search_depth(const AaState *st, const SmapReceiver *r, double z_re
         minmax_query(st->pyramid, face, (int)floor(r->mc.s - hs), (int)floor(r->mc.t - ht), (int)floor(r->mc.s + hs),
                      (int)floor(r->mc.t + ht), &lo, &hi);
         double z_min = smap_linear_depth(st->map, face, lo);
+        if (isnan(z_min)) return NAN; /* a NaN texel in the box: where blockers lie is unknown */
         if (!(z_min < z_receiver)) return 0.0;
         if (!(z_min > z)) break;
         z = z_min;
@@ -201,10 +212,12 @@ static double search_depth(const AaState *st, const SmapReceiver *r, double z_re
 }
 
 /* Average linear depth of the blockers the search taps find over the cone's
- * region at the search depth (seed 001 §3, after Annen et al.); 0 when none. */
+ * region at the search depth (seed 001 §3, after Annen et al.); 0 when none,
+ * NaN when a NaN depth was read. */
 static double average_blocker_depth(const AaState *st, const SmapReceiver *r, double z_receiver, int *tests)
 {
     double z_search = search_depth(st, r, z_receiver);
+    if (isnan(z_search)) return NAN;
     if (!(z_search > 0.0)) return 0.0;
     *tests = st->search_taps * st->search_taps;
     Region g = {st, r, &st->face[r->mc.face], 1.0 / z_search - 1.0 / z_receiver};
@@ -213,8 +226,9 @@ static double average_blocker_depth(const AaState *st, const SmapReceiver *r, do
     for (int b = 0; b < n; b++)
         for (int a = 0; a < n; a++) {
             int i, j;
-            if (!region_texel(&g, (a + 0.5) / n, (b + 0.5) / n, &i, &j) || smap_lit(st->map, r, i, j) > 0.0f) continue;
-            sum += smap_linear_depth(st->map, r->mc.face, shadowmap_texel(st->map, r->mc.face, i, j));
+            float lit = region_texel(&g, (a + 0.5) / n, (b + 0.5) / n, &i, &j) ? smap_lit(st->map, r, i, j) : 1.0f;
+            if (lit == 1.0f) continue;
+            sum += isnan(lit) ? NAN : smap_linear_depth(st->map, r->mc.face, shadowmap_texel(st->map, r->mc.face, i, j));
             found++;
         }
     return found ? sum / found : 0.0;
@@ -282,6 +296,10 @@ static int shade_receiver(const AaState *st, const SmapReceiver *r, int channels
     double z_p = r->mc.depth_linear;
     if (!(z_p > 0.0)) return 0;
     double z_avg = average_blocker_depth(st, r, z_p, tests);
+    if (isnan(z_avg)) { /* unknown blockers: no region to split, the visibility is unknown */
+        for (int c = 0; c < channels; c++) out[c] = NAN;
+        return 0;
+    }
     if (!(z_avg > 0.0)) return 0; /* no blocker in the cone: lit */
     /* The plane of the average blocker: z_avg >= near > 0 and z_avg < z_p
      * (blockers lie in front of the biased receiver), so k >= 0; k -> 0 at
@@ -291,7 +309,7 @@ static int shade_receiver(const AaState *st, const SmapReceiver *r, int channels
     int nodes, level = subdivide(&g, sum, &nodes);
     *tests += nodes * st->taps * st->taps;
     for (int c = 0; c < channels; c++) /* a channel the light does not emit has nothing to block */
-        out[c] = st->light_color[c] > 0.0f ? (float)fmin(fmax(sum[c] / st->light_color[c], 0.0), 1.0) : 1.0f;
+        out[c] = st->light_color[c] > 0.0f ? (float)nan_clamp(sum[c] / st->light_color[c], 0.0, 1.0) : 1.0f;
     return level;
 }
 
@@ -326,6 +344,7 @@ const Technique tech_adaptive_area = {
     .rgb = true,
     .lights = LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_TEXTURED_RECT),
     .main_param = "threshold",
+    .conditions = aa_conditions,
     .prepare = aa_prepare,
     .evaluate = aa_evaluate,
     .release = free,

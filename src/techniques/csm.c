@@ -18,7 +18,7 @@ enum { P_TERMS = FILTER_NUM_PARAMS, P_OFFSET, P_SCALE, P_DAMPING };
 
 static const ParamDesc csm_params[] = {
     SMAP_MAP_PARAMS,
-    SMAP_BIAS_PARAMS,
+    SMAP_DEPTH_BIAS_PARAMS,
     FILTER_PARAMS(PREFILTER_SAT),
     {"terms", PARAM_INT, 16, 1, CSM_MAX_TERMS, "terms",
      "M, the Fourier terms (2M channels; course: 16 is usual, 4 rings strongly, Fig. 4.7)", NULL},

@@ -15,11 +15,11 @@ static const char *const classifier_names[] = {"none", "value", "minmax", "nbuff
 enum { OUTPUT_VISIBILITY, OUTPUT_FALLBACK };
 static const char *const output_names[] = {"visibility", "fallback", NULL};
 
-enum { P_EXPONENT = FILTER_NUM_PARAMS, P_CLASSIFIER, P_OUTPUT };
+enum { P_EXPONENT = FILTER_NUM_PARAMS, P_CLASSIFIER, P_OUTPUT, P_RECEIVER_PLANE };
 
 static const ParamDesc esm_params[] = {
     SMAP_MAP_PARAMS,
-    SMAP_BIAS_PARAMS,
+    SMAP_DEPTH_BIAS_PARAMS,
     FILTER_PARAMS(PREFILTER_BOX),
     {"exponent", PARAM_FLOAT, 80, 0.1, 1000, "1 / normalised depth",
      "c of exp(c z) (course: 80); filtered in log space, so values past fp32's 88.7 and double's 709 stay "
@@ -34,8 +34,16 @@ static const ParamDesc esm_params[] = {
     {"output", PARAM_ENUM, OUTPUT_VISIBILITY, 0, 1, "",
      "visibility, or fallback: 1 where the sample was filtered by PCF, 0 elsewhere (the fallback share)",
      output_names},
+    SMAP_RECEIVER_PLANE_PARAM(0),
 };
 FILTER_CHECK_TABLE(esm_params);
+
+/* The receiver plane acts in the PCF fallback only: where a classifier
+ * flags a window, or where a SAT's window is below its rounding bound. */
+static const ParamCondition esm_conditions[] = {
+    {"receiver_plane", "classifier!=none or prefilter=sat"},
+    {NULL, NULL},
+};
 
 static const char *const esm_resources[] = {"shadow_map", "view_samples", "moments", "box_blur", "sat",
                                             "minmax_pyramid", "minmax_buffer", NULL};
@@ -58,6 +66,7 @@ static bool esm_prepare(const TechContext *ctx, void **state, Error *err)
     st->output = (int)p[P_OUTPUT];
     MomentSpec spec = {.warp = WARP_LOG_EXP, .order = 1, .c_pos = st->c};
     bool ok = filtered_acquire(ctx, spec, &st->fm, err);
+    st->fm.bias.receiver_plane = p[P_RECEIVER_PLANE] != 0.0;
     if (ok && st->classifier == CLASSIFY_MINMAX) ok = (st->pyramid = res_minmax_pyramid(ctx->rm, st->fm.map, err));
     if (ok && st->classifier == CLASSIFY_NBUFFER)
         ok = (st->nbuffer = res_minmax_buffer(ctx->rm, st->fm.map, minmax_buffer_level(st->fm.K), err));
@@ -83,7 +92,7 @@ static double esm_pcf(const EsmState *st, const FilteredSample *fs)
             int i = fp->i0 + a, j = fp->j0 + b;
             double u_q = prefilter_depth_unit(m, face, shadowmap_texel(m, face, i, j));
             double d_q = prefilter_depth_unit(m, face, smap_ref_at(&fs->r, i, j));
-            lit += wy * pf_weight(fp, a, fp->ax) * fmin(1.0, exp(st->c * (u_q - d_q)));
+            lit += wy * pf_weight(fp, a, fp->ax) * nan_min(1.0, exp(st->c * (u_q - d_q)));
         }
     }
     return lit / ((double)fp->K * fp->K);
@@ -103,6 +112,7 @@ static Verdict classify(const EsmState *st, const FilteredSample *fs, double esm
     float zmin, zmax;
     if (st->pyramid) minmax_query(st->pyramid, fs->r.mc.face, fp->i0, fp->j0, fp->i0 + last, fp->j0 + last, &zmin, &zmax);
     else minmax_buffer_query(st->nbuffer, fs->r.mc.face, fp->i0, fp->j0, fp->i0 + last, fp->j0 + last, &zmin, &zmax);
+    if (isnan(zmin) || isnan(zmax)) return VERDICT_PCF; /* a NaN texel: the per-texel terms carry it */
     if (zmin >= fs->r.ref) return VERDICT_LIT;  /* nothing in front: every test passes */
     return zmax > fs->r.ref ? VERDICT_PCF : VERDICT_ESM;
 }
@@ -119,7 +129,7 @@ static void esm_evaluate(const void *state, const TechContext *ctx, int begin, i
             double esm = exp(fs.m[0] - st->c * fs.u);
             switch (classify(st, &fs, esm)) {
             case VERDICT_LIT: v = 1.0; break;
-            case VERDICT_ESM: v = fmin(1.0, esm); break;
+            case VERDICT_ESM: v = nan_min(1.0, esm); break;
             case VERDICT_PCF: v = esm_pcf(st, &fs); fallback = 1.0; break;
             }
         }
@@ -138,6 +148,7 @@ const Technique tech_esm = {
     .rgb = false,
     .lights = LIGHTS_ALL,
     .main_param = "K",
+    .conditions = esm_conditions,
     .prepare = esm_prepare,
     .evaluate = esm_evaluate,
     .release = free,

@@ -19,7 +19,7 @@ bool filtered_acquire(const TechContext *ctx, MomentSpec spec, FilteredMaps *fm,
     fm->K = (int)p[FILTER_P_K];
     fm->bilinear = (int)p[FILTER_P_LOOKUP] == FILTER_LOOKUP_BILINEAR;
     fm->pf = res_prefiltered(ctx->rm, mm, (PrefilterKind)(int)p[FILTER_P_PREFILTER], fm->K, err);
-    fm->bias = smap_bias(p, ctx->scene);
+    fm->bias = smap_depth_bias(p, ctx->scene);
     fm->bias.filter_radius = 0.5 * (fm->K - 1); /* as pcf's: the same slope bias for the same window */
     return fm->pf != NULL;
 }
@@ -35,6 +35,7 @@ bool filtered_lookup(const FilteredMaps *fm, const TechContext *ctx, int s, Filt
 
 double chebyshev_upper(double mean, double m2, double d, double min_variance)
 {
+    if (isnan(mean) || isnan(m2) || isnan(d)) return NAN; /* an unknown moment: no bound */
     if (!(d > mean)) return 1.0;
     double var = fmax(m2 - mean * mean, min_variance), t = d - mean, den = var + t * t;
     return den > 0.0 ? var / den : 1.0; /* den = 0: var = 0 and (d - mean)^2 underflowed, d == mean in effect */

@@ -1,13 +1,14 @@
 /* filtered.h -- what the prefiltered shadow-map techniques of course ch.4
  * (vsm, lvsm, evsm, msm in vsm.c; esm.c; csm.c) share: the filter's
  * parameters, declared once and expanded after SMAP_MAP_PARAMS and
- * SMAP_BIAS_PARAMS; the chain of keyed resources depth map -> moment map ->
+ * SMAP_DEPTH_BIAS_PARAMS (no receiver plane: see below); the chain of keyed resources depth map -> moment map ->
  * box blur or SAT (resources/prefilter.h); and the lookup of a view sample:
  * its normalised reference depth and the window's filtered moments.
  *
  * The reference depth is the lead's biased smap_receiver depth at the
  * sample; per-texel receiver-plane depths exist only where a technique tests
- * texels one by one (ESM's PCF fallback). */
+ * texels one by one, so only esm (its PCF fallback) declares receiver_plane,
+ * among its own parameters. */
 #ifndef SL_FILTERED_H
 #define SL_FILTERED_H
 #include "resources/prefilter.h"
@@ -38,7 +39,7 @@ enum { FILTER_LOOKUP_NEAREST, FILTER_LOOKUP_BILINEAR };
      "catalogue: an fp32 SAT destroys moment differences)",                                                        \
      filter_precision_names}
 
-enum { FILTER_P_K = SMAP_NUM_PARAMS, FILTER_P_PREFILTER, FILTER_P_LOOKUP, FILTER_P_PRECISION, FILTER_NUM_PARAMS };
+enum { FILTER_P_K = SMAP_NUM_DEPTH_BIAS_PARAMS, FILTER_P_PREFILTER, FILTER_P_LOOKUP, FILTER_P_PRECISION, FILTER_NUM_PARAMS };
 
 /* A technique's parameter table fits the registry's limit (the shared map
  * parameters grow as the lead adds remedies). */
@@ -54,7 +55,8 @@ typedef struct FilteredMaps {
 } FilteredMaps;
 
 /* Acquire the depth map, the moment map of `spec` (its precision taken
- * from the parameters) and its prefiltered form. */
+ * from the parameters) and its prefiltered form; fm->bias without the
+ * receiver plane (smap_depth_bias). */
 bool filtered_acquire(const TechContext *ctx, MomentSpec spec, FilteredMaps *fm, Error *err);
 
 /* A view sample seen through the filtered map. */
@@ -72,7 +74,8 @@ bool filtered_lookup(const FilteredMaps *fm, const TechContext *ctx, int s, Filt
 /* course Eq. 4.2, the one-sided Chebyshev (Cantelli) bound on the lit
  * fraction from a window's mean and second moment at reference d:
  * p = var / (var + (d - mean)^2) for d > mean, else 1, with the variance
- * (the text's "sigma", erratum 1) clamped below by min_variance. */
+ * (the text's "sigma", erratum 1) clamped below by min_variance; NaN when
+ * a moment or d is NaN (a NaN depth in the window). */
 double chebyshev_upper(double mean, double m2, double d, double min_variance);
 /* course §4.2.2: light-bleeding reduction, p < amount -> 0 and [amount, 1]
  * smoothstep-remapped onto [0, 1]; amount 0 leaves p unchanged. */

@@ -30,6 +30,14 @@ static const ParamDesc pcf_params[] = {
     {"rotate", PARAM_BOOL, 1, 0, 1, "", "poisson and adaptive: rotate the disk per pixel (banding becomes noise)", NULL},
 };
 
+/* The disk's taps and rotation; the first taps only in adaptive PCF. */
+static const ParamCondition pcf_conditions[] = {
+    {"samples", "kernel=poisson|adaptive"},
+    {"initial", "kernel=adaptive"},
+    {"rotate", "kernel=poisson|adaptive"},
+    {NULL, NULL},
+};
+
 static const char *const pcf_resources[] = {"shadow_map", "view_samples", "point_table", NULL};
 
 typedef struct PcfState {
@@ -93,18 +101,27 @@ static bool pcf_prepare(const TechContext *ctx, void **state, Error *err)
 }
 
 /* Lit taps of row j (clamped to the edge, like shadowmap_texel) over
- * columns [i0, i0 + K) against one reference depth: smap_lit's test with the
- * row addressed once and no per-tap branch, so the interior loop vectorises. */
-static int box_row_lit(const ShadowMap *m, int face, int i0, int j, int K, double ref)
+ * columns [i0, i0 + K) against one reference depth: smap_test with the row
+ * addressed once and no per-tap branch, so the interior loop vectorises.
+ * Lit and shadowed taps are counted apart: a NaN texel (or reference) is
+ * neither, and makes the row NaN. */
+static float box_row_lit(const ShadowMap *m, int face, int i0, int j, int K, double ref)
 {
-    int res = m->res, jc = j < 0 ? 0 : j >= res ? res - 1 : j, lit = 0;
+    int res = m->res, jc = j < 0 ? 0 : j >= res ? res - 1 : j, lit = 0, shadowed = 0;
     const float *row = m->depth + ((size_t)face * (size_t)res + (size_t)jc) * (size_t)res;
     if (i0 >= 0 && i0 + K <= res) {
-        for (int i = i0; i < i0 + K; i++) lit += !(ref > row[i]);
-        return lit;
+        for (int i = i0; i < i0 + K; i++) {
+            lit += ref <= row[i];
+            shadowed += ref > row[i];
+        }
+    } else {
+        for (int i = i0; i < i0 + K; i++) {
+            float z = row[i < 0 ? 0 : i >= res ? res - 1 : i];
+            lit += ref <= z;
+            shadowed += ref > z;
+        }
     }
-    for (int i = i0; i < i0 + K; i++) lit += !(ref > row[i < 0 ? 0 : i >= res ? res - 1 : i]);
-    return lit;
+    return lit + shadowed == K ? (float)lit : NAN;
 }
 
 /* Box: K x K texel centres around (s, t); the first is at floor(s - K/2 + 1/2). */
@@ -116,7 +133,7 @@ static float filter_box(const PcfState *st, const SmapReceiver *r)
         for (int j = j0; j < j0 + st->K; j++)
             for (int i = i0; i < i0 + st->K; i++) lit += smap_lit(st->map, r, i, j);
     } else {
-        for (int j = j0; j < j0 + st->K; j++) lit += (float)box_row_lit(st->map, r->mc.face, i0, j, st->K, r->ref);
+        for (int j = j0; j < j0 + st->K; j++) lit += box_row_lit(st->map, r->mc.face, i0, j, st->K, r->ref);
     }
     return lit / (float)(st->K * st->K);
 }
@@ -138,15 +155,16 @@ static float filter_bilinear(const PcfState *st, const SmapReceiver *r)
     return (float)(lit / ((double)st->K * st->K));
 }
 
-/* Taps [first, last) of the disk of diameter K texels, rotated by angle. */
-static int disk_lit(const PcfState *st, const SmapReceiver *r, int first, int last, double cs, double sn)
+/* Lit taps [first, last) of the disk of diameter K texels, rotated by
+ * angle; NaN if a tap reads a NaN depth. */
+static float disk_lit(const PcfState *st, const SmapReceiver *r, int first, int last, double cs, double sn)
 {
     double radius = 0.5 * st->K;
-    int lit = 0;
+    float lit = 0.0f;
     for (int k = first; k < last; k++) {
         double x = st->disk->pts[k][0], y = st->disk->pts[k][1];
         double s = r->mc.s + radius * (cs * x - sn * y), t = r->mc.t + radius * (sn * x + cs * y);
-        lit += smap_lit(st->map, r, (int)floor(s), (int)floor(t)) > 0.0f;
+        lit += smap_lit(st->map, r, (int)floor(s), (int)floor(t));
     }
     return lit;
 }
@@ -156,10 +174,10 @@ static float filter_disk(const PcfState *st, const SmapReceiver *r, uint32_t sam
     double a = st->rotate ? 2.0 * M_PI * (hash_u32(sample) >> 8) / 16777216.0 : 0.0;
     double cs = cos(a), sn = sin(a);
     int n0 = st->kernel == KERNEL_ADAPTIVE ? st->initial : st->samples;
-    int lit = disk_lit(st, r, 0, n0, cs, sn);
-    if (n0 == st->samples || lit == 0 || lit == n0) return (float)lit / (float)n0;
+    float lit = disk_lit(st, r, 0, n0, cs, sn);
+    if (n0 == st->samples || lit == 0.0f || lit == (float)n0) return lit / (float)n0; /* NaN: the full disk */
     lit += disk_lit(st, r, n0, st->samples, cs, sn);
-    return (float)lit / (float)st->samples;
+    return lit / (float)st->samples;
 }
 
 static void pcf_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
@@ -191,6 +209,7 @@ const Technique tech_pcf = {
     .rgb = false,
     .lights = LIGHTS_ALL,
     .main_param = "K",
+    .conditions = pcf_conditions,
     .prepare = pcf_prepare,
     .evaluate = pcf_evaluate,
     .release = free,

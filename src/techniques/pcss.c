@@ -26,8 +26,9 @@ enum { P_SAMPLING = SMAP_NUM_PARAMS, P_BLOCKER_TAPS, P_FILTER_TAPS, P_ROTATE, P_
 
 #define PCSS_MIN_HALF 0.5 /* texels: the filter is at least one texel wide (sub-texel kernels alias) */
 
+/* Plain perspective faces only (softmap.h): no warps or frustum-face splits. */
 static const ParamDesc pcss_params[] = {
-    SMAP_MAP_PARAMS,
+    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_CUBE, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT),
     SMAP_BIAS_PARAMS_PLANE(1),
     {"sampling", PARAM_ENUM, SAMPLING_POISSON, 0, 2, "",
      "how both windows are read: poisson (disk taps, rotated per pixel), regular (an n x n grid of taps) or "
@@ -43,6 +44,14 @@ static const ParamDesc pcss_params[] = {
      "bound on the search and filter half-widths: wider windows (a huge light, a receiver near the light or a "
      "blocker depth near 0, course §5.2.2.1) are clamped to it",
      NULL},
+};
+
+/* Exhaustive windows read every texel: no taps, no disk to rotate. */
+static const ParamCondition pcss_conditions[] = {
+    {"blocker_taps", "sampling=poisson|regular"},
+    {"filter_taps", "sampling=poisson|regular"},
+    {"rotate", "sampling=poisson"},
+    {NULL, NULL},
 };
 
 static const char *const pcss_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", "point_table", NULL};
@@ -114,22 +123,25 @@ typedef struct Window { double hx, hy; } Window;
 static Window window(const PcssState *st, const SoftFace *f, double hx_tangent, double hy_tangent)
 {
     Window w = {hx_tangent / f->dx, hy_tangent / f->dy};
-    w.hx = fmin(fmax(w.hx, PCSS_MIN_HALF), st->max_radius);
-    w.hy = fmin(fmax(w.hy, PCSS_MIN_HALF), st->max_radius);
+    w.hx = nan_clamp(w.hx, PCSS_MIN_HALF, st->max_radius);
+    w.hy = nan_clamp(w.hy, PCSS_MIN_HALF, st->max_radius);
     return w;
 }
 
 typedef struct Blockers { int count; double depth_sum; } Blockers;
 
+/* A blocker adds its linear depth; a NaN depth (or reference) adds NaN:
+ * the average is then unknown, not the average of the others. */
 static void blocker_add(const PcssState *st, const SmapReceiver *r, int i, int j, Blockers *b)
 {
-    float stored = shadowmap_texel(st->sm.map, r->mc.face, i, j);
-    if (!(smap_ref_at(r, i, j) > stored)) return;
+    float stored = shadowmap_texel(st->sm.map, r->mc.face, i, j), lit = smap_test(smap_ref_at(r, i, j), stored);
+    if (lit == 1.0f) return;
     b->count++;
-    b->depth_sum += smap_linear_depth(st->sm.map, r->mc.face, stored);
+    b->depth_sum += isnan(lit) ? NAN : smap_linear_depth(st->sm.map, r->mc.face, stored);
 }
 
-/* Step 1: the average linear depth of the blockers in the window; false if none. */
+/* Step 1: the average linear depth of the blockers in the window (NaN if
+ * one read NaN); false if none. */
 static bool blocker_depth(const PcssState *st, const SmapReceiver *r, Window w, double cs, double sn, double *z_avg)
 {
     Blockers b = {0, 0.0};
@@ -171,13 +183,13 @@ static double filter_box(const PcssState *st, const SmapReceiver *r, Window w)
 
 static double filter_taps(const PcssState *st, const SmapReceiver *r, Window w, double cs, double sn)
 {
-    int lit = 0;
+    double lit = 0.0;
     for (int k = 0; k < st->filter.taps; k++) {
         double x, y;
         tap(&st->filter, st->sampling == SAMPLING_REGULAR, k, cs, sn, &x, &y);
-        lit += smap_lit(st->sm.map, r, (int)floor(r->mc.s + w.hx * x), (int)floor(r->mc.t + w.hy * y)) > 0.0f;
+        lit += smap_lit(st->sm.map, r, (int)floor(r->mc.s + w.hx * x), (int)floor(r->mc.t + w.hy * y));
     }
-    return (double)lit / st->filter.taps;
+    return lit / st->filter.taps;
 }
 
 static float visibility(const PcssState *st, const SmapReceiver *r, uint32_t sample)
@@ -189,8 +201,9 @@ static float visibility(const PcssState *st, const SmapReceiver *r, uint32_t sam
     double k_search = (z_p - z_n) / (z_p * z_n); /* the pyramid on the near plane, per unit of light half-extent */
     double z_avg;
     if (!blocker_depth(st, r, window(st, f, L->half_x * k_search, L->half_y * k_search), cs, sn, &z_avg)) return 1.0f;
+    if (isnan(z_avg)) return NAN; /* no window to filter over: the sample's visibility is unknown */
     /* d_blocker -> 0: blockers lie beyond the near plane (quantised depths may read slightly before it) */
-    z_avg = fmin(fmax(z_avg, z_n), z_p);
+    z_avg = nan_clamp(z_avg, z_n, z_p);
     double k_filter = (z_p - z_avg) / (z_avg * z_p);
     Window w = window(st, f, L->half_x * k_filter, L->half_y * k_filter);
     return (float)(st->sampling == SAMPLING_EXHAUSTIVE ? filter_box(st, r, w) : filter_taps(st, r, w, cs, sn));
@@ -221,6 +234,7 @@ const Technique tech_pcss = {
     .rgb = false,
     .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),
     .main_param = "filter_taps",
+    .conditions = pcss_conditions,
     .prepare = pcss_prepare,
     .evaluate = pcss_evaluate,
     .release = free,

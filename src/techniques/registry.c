@@ -1,6 +1,7 @@
 /* registry.c -- the technique table and shared parameter handling. Adding a
  * technique is one file in this folder and one line in `registry` below. */
 #include "techniques/registry.h"
+#include "techniques/smap.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -133,17 +134,11 @@ static bool refuse(const Technique *t, const ParamDesc *p, const char *what, Err
                      param_type_name(p->type), range);
 }
 
-bool tech_param_set(const Technique *t, const char *name, double v, double *values, Error *err)
+static bool condition_possible(const Technique *t, int k);
+
+/* Check value v for parameter i and store it. */
+static bool set_value(const Technique *t, int i, double v, double *values, Error *err)
 {
-    int i = tech_param_index(t, name);
-    if (i < 0) {
-        char known[512] = "";
-        size_t used = 0;
-        for (int k = 0; k < t->num_params && used < sizeof known; k++)
-            used += (size_t)snprintf(known + used, sizeof known - used, "%s%s", k ? ", " : "", t->params[k].name);
-        return error_set(err, "%s: unknown parameter '%s' (parameters: %s)", t->name, name,
-                         t->num_params ? known : "none");
-    }
     const ParamDesc *p = &t->params[i];
     char text[64];
     snprintf(text, sizeof text, "%.9g", v);
@@ -155,11 +150,31 @@ bool tech_param_set(const Technique *t, const char *name, double v, double *valu
     return true;
 }
 
+bool tech_param_set(const Technique *t, const char *name, double v, double *values, Error *err)
+{
+    int i = tech_param_index(t, name);
+    if (i < 0) {
+        char known[512] = "";
+        size_t used = 0;
+        for (int k = 0; k < t->num_params && used < sizeof known; k++)
+            if (tech_param_offered(t, k))
+                used += (size_t)snprintf(known + used, sizeof known - used, "%s%s", used ? ", " : "", t->params[k].name);
+        return error_set(err, "%s: unknown parameter '%s' (parameters: %s)", t->name, name,
+                         t->num_params ? known : "none");
+    }
+    double scratch[TECH_MAX_PARAMS];
+    if (!condition_possible(t, i) && v != t->params[i].def) /* its default: what leaving it out means */
+        return set_value(t, i, v, scratch, err) && /* an ill-typed value: refused with the range */
+               error_set(err, "%s: parameter '%s' is not one of its own: it acts only when %s, which %s does not take",
+                         t->name, name, tech_param_when(t, i), t->name);
+    return set_value(t, i, v, values, err);
+}
+
 bool tech_params_check(const Technique *t, const double *values, Error *err)
 {
     double scratch[TECH_MAX_PARAMS];
     for (int i = 0; i < t->num_params; i++)
-        if (!tech_param_set(t, t->params[i].name, values[i], scratch, err)) return false;
+        if (!set_value(t, i, values[i], scratch, err)) return false;
     return true;
 }
 
@@ -192,4 +207,177 @@ bool tech_param_parse(const Technique *t, const char *assignment, double *values
     double v;
     if (!parse_value(&t->params[i], eq + 1, &v)) return refuse(t, &t->params[i], eq + 1, err);
     return tech_param_set(t, name, v, values, err);
+}
+
+/* ---- conditions (Technique.conditions, smap_conditions) ---- */
+
+const char *tech_param_when(const Technique *t, int k)
+{
+    const char *name = t->params[k].name;
+    for (const ParamCondition *c = t->conditions; c && c->param; c++)
+        if (strcmp(c->param, name) == 0) return c->when;
+    if (k < SMAP_P_BIAS && smap_has_map_params(t)) /* the shared block's own */
+        for (const ParamCondition *c = smap_conditions; c->param; c++)
+            if (strcmp(c->param, name) == 0) return c->when;
+    return NULL;
+}
+
+#define COND_MAX_CLAUSES 8
+#define COND_MAX_VALUES 16
+
+/* One clause NAME=V1|V2 (or NAME!=...); `alternative` starts an " or " branch. */
+typedef struct CondClause {
+    int param;
+    bool negate, alternative;
+    int n;
+    double v[COND_MAX_VALUES];
+} CondClause;
+
+/* A clause NAME=V1|V2 (or NAME!=...). Values outside the technique's range
+ * of NAME are dropped: the shared map block's conditions name every warp,
+ * and a technique that accepts fewer keeps the clause's other values. */
+static bool clause_parse(const Technique *t, const char *who, char *text, CondClause *c, Error *err)
+{
+    char *eq = strchr(text, '=');
+    if (!eq || eq == text) return error_set(err, "%s: condition '%s' of %s: expected NAME=VALUE", t->name, text, who);
+    c->negate = eq[-1] == '!';
+    *(c->negate ? eq - 1 : eq) = '\0';
+    c->param = tech_param_index(t, text);
+    if (c->param < 0) return error_set(err, "%s: condition of %s names no parameter '%s'", t->name, who, text);
+    const ParamDesc *p = &t->params[c->param];
+    c->n = 0;
+    char *save = NULL;
+    for (char *v = strtok_r(eq + 1, "|", &save); v; v = strtok_r(NULL, "|", &save)) {
+        double x;
+        if (c->n == COND_MAX_VALUES || !parse_value(p, v, &x))
+            return error_set(err, "%s: condition of %s: '%s' is not a value of %s", t->name, who, v, p->name);
+        if (x >= p->min && x <= p->max) c->v[c->n++] = x;
+    }
+    return true;
+}
+
+/* The clauses of parameter k's condition; 0 when it has none, -1 on a malformed one. */
+static int condition_parse(const Technique *t, int k, CondClause *c, Error *err)
+{
+    const char *text = tech_param_when(t, k);
+    if (!text) return 0;
+    char buf[512], *save = NULL;
+    snprintf(buf, sizeof buf, "%s", text);
+    int n = 0;
+    bool alternative = true;
+    for (char *w = strtok_r(buf, " ", &save); w; w = strtok_r(NULL, " ", &save)) {
+        if (strcmp(w, "or") == 0 || strcmp(w, "and") == 0) {
+            if (alternative || n == 0) break; /* two joins in a row, or a join first */
+            alternative = w[0] == 'o';
+            continue;
+        }
+        if (n == COND_MAX_CLAUSES || !clause_parse(t, t->params[k].name, w, &c[n], err)) return -1;
+        c[n++].alternative = alternative;
+        alternative = false;
+    }
+    if (n == 0 || alternative) {
+        error_set(err, "%s: condition '%s' of %s: expected clauses joined by 'and' or 'or'", t->name, text,
+                  t->params[k].name);
+        return -1;
+    }
+    return n;
+}
+
+static bool clause_holds(const CondClause *c, const double *values)
+{
+    bool listed = false;
+    for (int i = 0; i < c->n; i++) listed = listed || values[c->param] == c->v[i];
+    return listed != c->negate;
+}
+
+bool tech_param_condition_check(const Technique *t, int k, Error *err)
+{
+    CondClause c[COND_MAX_CLAUSES];
+    return condition_parse(t, k, c, err) >= 0;
+}
+
+/* The end of the alternative (the " or " branch) that starts at clause i. */
+static int alternative_end(const CondClause *c, int n, int i)
+{
+    while (++i < n && !c[i].alternative) {}
+    return i;
+}
+
+bool tech_param_acts(const Technique *t, int k, const double *values)
+{
+    CondClause c[COND_MAX_CLAUSES];
+    Error err;
+    int n = condition_parse(t, k, c, &err);
+    if (n <= 0) return true; /* none (a malformed one is refused by the registry's test) */
+    for (int a = 0, b; a < n; a = b) {
+        b = alternative_end(c, n, a);
+        bool holds = true;
+        for (int i = a; i < b; i++) holds = holds && clause_holds(&c[i], values);
+        if (holds) return true;
+    }
+    return false;
+}
+
+/* A value that satisfies clause c within its parameter's range: the first
+ * listed value, or for NAME!=... the first not listed of the default, the
+ * integers above the minimum and the range's ends; false when none does. */
+static bool clause_value(const Technique *t, const CondClause *c, double *v)
+{
+    if (!c->negate) {
+        *v = c->v[0];
+        return c->n > 0;
+    }
+    const ParamDesc *p = &t->params[c->param];
+    double tries[COND_MAX_VALUES + 4] = {p->def};
+    int n = 1;
+    for (double x = p->min + 1.0; p->type != PARAM_FLOAT && x < p->max && n < COND_MAX_VALUES + 2; x++)
+        tries[n++] = x;
+    tries[n++] = p->min;
+    tries[n++] = p->max;
+    for (int i = 0; i < n; i++) {
+        bool listed = false;
+        for (int j = 0; j < c->n; j++) listed = listed || tries[i] == c->v[j];
+        if (!listed) {
+            *v = tries[i];
+            return true;
+        }
+    }
+    return false;
+}
+
+/* The first alternative of parameter k's condition that can hold within the
+ * technique's ranges: its clauses [*a, *b); false when none can. */
+static bool possible_alternative(const Technique *t, const CondClause *c, int n, int *a, int *b)
+{
+    for (*a = 0; *a < n; *a = *b) {
+        *b = alternative_end(c, n, *a);
+        bool possible = true;
+        double v;
+        for (int i = *a; i < *b; i++) possible = possible && clause_value(t, &c[i], &v);
+        if (possible) return true;
+    }
+    return false;
+}
+
+/* Can parameter k's condition hold within the technique's ranges? */
+static bool condition_possible(const Technique *t, int k)
+{
+    CondClause c[COND_MAX_CLAUSES];
+    Error err;
+    int n = condition_parse(t, k, c, &err), a, b;
+    return n <= 0 || possible_alternative(t, c, n, &a, &b);
+}
+
+bool tech_param_offered(const Technique *t, int k)
+{
+    return t->params[k].min < t->params[k].max && condition_possible(t, k); /* one value: nothing to choose */
+}
+
+void tech_param_enable(const Technique *t, int k, double *values)
+{
+    CondClause c[COND_MAX_CLAUSES];
+    Error err;
+    int n = condition_parse(t, k, c, &err), a, b;
+    if (n > 0 && possible_alternative(t, c, n, &a, &b))
+        for (int i = a; i < b; i++) clause_value(t, &c[i], &values[c[i].param]);
 }

@@ -32,6 +32,25 @@ const char *param_type_name(ParamType t);
 void tech_lights_text(const Technique *t, char *out, size_t n);
 /* Refuse a light the technique does not handle, naming what it handles. */
 bool tech_check_light(const Technique *t, const Light *light, int light_number, Error *err);
+/* Parameter k's condition (ParamCondition.when): the technique's own, else
+ * the shared map block's (smap_conditions); NULL when it always acts. */
+const char *tech_param_when(const Technique *t, int k);
+/* Does parameter k act under these values: its condition holds, or it has none? A parameter that does not act changes no output, so
+ * the configuration key leaves it out. */
+bool tech_param_acts(const Technique *t, int k, const double *values);
+/* Can parameter k's condition hold at all within the technique's ranges (a
+ * shared map parameter that acts only under warps, in a technique that takes
+ * no warps, cannot), and does its range hold two values? One that cannot or
+ * does not is not the technique's: `list`, the docs and the Lua
+ * descriptions leave it out, and setting it to anything but its default is
+ * refused by name (its default is accepted: records and round trips name
+ * every parameter). */
+bool tech_param_offered(const Technique *t, int k);
+/* Set the parameters that parameter k's condition names so that its first
+ * possible alternative holds (the registry-wide parameter test varies k there). */
+void tech_param_enable(const Technique *t, int k, double *values);
+/* Refuse a malformed condition: unknown names, values outside a range. */
+bool tech_param_condition_check(const Technique *t, int k, Error *err);
 /* Does the technique declare resource kind `kind` (Technique.resources)? */
 bool tech_acquires(const Technique *t, const char *kind);
 

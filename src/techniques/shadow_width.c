@@ -46,6 +46,9 @@ static const ParamDesc sw_params[] = {
      filter_names},
 };
 
+/* c_bias offsets 1 - c_scale sw / sd, which c_scale = 0 makes 1 everywhere. */
+static const ParamCondition sw_conditions[] = {{"c_bias", "c_scale!=0"}, {NULL, NULL}};
+
 static const char *const sw_resources[] = {"shadow_map", "shadow_width_map", "view_samples", NULL};
 static const char *const sw_aux[] = {"shadow_width", "shadow_depth", NULL};
 
@@ -85,10 +88,11 @@ static bool sw_prepare(const TechContext *ctx, void **state, Error *err)
  * overflows and c_scale = 0 (I = 1) needs no special case. */
 static double attenuation(double sd, double sw, double c_scale, double c_bias)
 {
+    if (isnan(sd) || isnan(sw)) return NAN; /* a NaN depth or width: unknown, not lit */
     if (!(sd > 0.0)) return 1.0;
     double x = c_scale * sw;
     if (x >= (1.0 + c_bias) * sd) return 0.0;
-    return fmin(1.0, 1.0 + c_bias - x / sd);
+    return nan_min(1.0, 1.0 + c_bias - x / sd);
 }
 
 /* Shadow depth (world units) and width (texels) at the receiver. */
@@ -148,6 +152,7 @@ const Technique tech_shadow_width = {
     .rgb = false,
     .lights = LIGHTS_ALL,
     .main_param = "c_scale",
+    .conditions = sw_conditions,
     .prepare = sw_prepare,
     .evaluate = sw_evaluate,
     .release = free,

@@ -26,6 +26,12 @@ static const ParamDesc sm_params[] = {
      "dual layers: the fixed distance threshold delta_max beyond the first layer", NULL},
 };
 
+static const ParamCondition sm_conditions[] = {
+    {"second_layer", "layers=second_depth|midpoint|dual"},
+    {"dual_max", "layers=dual"},
+    {NULL, NULL},
+};
+
 static const char *const sm_resources[] = {"shadow_map", "view_samples", NULL};
 
 typedef struct SmState {
@@ -68,7 +74,7 @@ static double occluder_depth(const SmState *st, const SmapReceiver *r, int i, in
     if (st->layers == LAYERS_MIDPOINT) return 0.5 * (z1 + z2); /* one layer only (z2 = inf): lit, Fig. 2.3's failure */
     double delta = st->dual_max_world; /* no second layer: the gap is unbounded, the threshold applies */
     if (m->spec.depth == RASTER_DEPTH_NDC) delta *= lightview_ndc_per_world(&m->view, &r->mc);
-    return z1 + fmin(delta, 0.5 * (z2 - z1));
+    return z1 + nan_min(delta, 0.5 * (z2 - z1));
 }
 
 static void sm_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
@@ -82,7 +88,7 @@ static void sm_evaluate(const void *state, const TechContext *ctx, int begin, in
         if (smap_receiver(m, &st->bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r)) {
             int i, j;
             smap_texel(&r, &i, &j);
-            v = smap_ref_at(&r, i, j) > occluder_depth(st, &r, i, j) ? 0.0f : 1.0f;
+            v = smap_test(smap_ref_at(&r, i, j), occluder_depth(st, &r, i, j));
         }
         tech_store(ctx, out, begin, s, v);
     }
@@ -99,6 +105,7 @@ const Technique tech_sm = {
     .rgb = false,
     .lights = LIGHTS_ALL,
     .main_param = "map_size",
+    .conditions = sm_conditions,
     .prepare = sm_prepare,
     .evaluate = sm_evaluate,
     .release = free,

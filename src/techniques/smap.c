@@ -11,6 +11,35 @@ const char *const smap_falloff_names[] = {WARP_FALLOFF_NAMES, NULL};
 const char *const smap_split_names[] = {SPLIT_SCHEME_NAMES, NULL};
 const char *const smap_select_names[] = {CASCADE_SELECT_NAMES, NULL};
 
+/* What each view parameter shapes (resources/shadowmap.c's relevant_params,
+ * resources/warp.c's warp_n, lightview.c's fit_face): a warp's n and falloff
+ * (lispsm, logpsm; tsm's falloff), a free n, TSM's focus, the splits of a
+ * partitioned map (cascades, or the frustum's faces), stable extents
+ * (unwarped faces: ortho and perspective maps, also per cascade, and the
+ * flat near and far faces of a face partition, lightview.c's
+ * fit_face_partition). A condition may be wider than where the parameter
+ * acts (stabilize with an auto projection that resolves to a cube), never
+ * narrower: the configuration key leaves out what it excludes. A technique that takes none of the listed
+ * values (adaptive_area: no warps) is not offered the parameter. */
+#define SMAP_WARPED "projection=psm|lispsm|tsm|logpsm"
+#define SMAP_PARTED "cascades!=1 or split_scheme=faces"
+const ParamCondition smap_conditions[] = {
+    {"warp_n", "projection=lispsm|logpsm and warp_n_world=0"},
+    {"warp_n_world", "projection=lispsm|logpsm"},
+    {"warp_falloff", "projection=lispsm|logpsm and warp_n_world=0 or projection=tsm"},
+    {"pseudo_near", SMAP_WARPED " or " SMAP_PARTED},
+    {"tsm_focus", "projection=tsm"},
+    {"stabilize", "projection=auto|perspective|ortho or split_scheme=faces"}, /* faces: near and far are flat */
+    {"split_scheme", SMAP_PARTED},
+    {"split_lambda", "split_scheme=practical and cascades!=1"},
+    {"split_1", "split_scheme=explicit and cascades=2|3|4"},
+    {"split_2", "split_scheme=explicit and cascades=3|4"},
+    {"split_3", "split_scheme=explicit and cascades=4"},
+    {"cascade_select", SMAP_PARTED},
+    {"cascade_blend", SMAP_PARTED},
+    {NULL, NULL},
+};
+
 _Static_assert(SMAP_P_SPLIT_3 - SMAP_P_SPLIT_1 + 1 == LIGHTVIEW_EXPLICIT_SPLITS, "one split_k per explicit distance");
 
 ShadowMapSpec smap_spec(const double *p)
@@ -43,10 +72,17 @@ bool smap_has_map_params(const Technique *t)
     return true;
 }
 
-SmapBias smap_bias(const double *p, const Scene *scene)
+SmapBias smap_depth_bias(const double *p, const Scene *scene)
 {
     return (SmapBias){p[SMAP_P_BIAS], p[SMAP_P_BIAS_STEPS], p[SMAP_P_SLOPE_BIAS], p[SMAP_P_SLOPE_MAX],
-                      p[SMAP_P_NORMAL_OFFSET], p[SMAP_P_RECEIVER_PLANE] != 0.0, scene_extent(scene), 0.0};
+                      p[SMAP_P_NORMAL_OFFSET], false, scene_extent(scene), 0.0};
+}
+
+SmapBias smap_bias(const double *p, const Scene *scene)
+{
+    SmapBias b = smap_depth_bias(p, scene);
+    b.receiver_plane = p[SMAP_P_RECEIVER_PLANE] != 0.0;
+    return b;
 }
 
 /* World size of one step of the stored depth at the receiver (the r of
@@ -58,7 +94,7 @@ static double depth_step_world(const ShadowMap *m, const MapCoord *mc, double nd
     if (m->spec.depth == RASTER_DEPTH_LINEAR)
         return bits ? (rv->depth_far - rv->depth_near) / (double)((1u << bits) - 1u)
                     : fabs(mc->depth_linear) * FLT_EPSILON;
-    double step_ndc = bits ? 1.0 / (double)((1u << bits) - 1u) : fmax(fabs(mc->z_ndc), FLT_MIN) * FLT_EPSILON;
+    double step_ndc = bits ? 1.0 / (double)((1u << bits) - 1u) : nan_max(fabs(mc->z_ndc), FLT_MIN) * FLT_EPSILON;
     return step_ndc / ndc_per_world;
 }
 
@@ -104,7 +140,7 @@ static bool receiver_plane(const ShadowMap *m, SmapReceiver *r, dvec3 q, dvec3 n
 static double depth_slope(const SmapReceiver *r)
 {
     double k = r->reciprocal ? 1.0 / (r->g0 * r->g0) : 1.0; /* d = 1/g: |dd| = |dg| / g^2 */
-    return fmax(fabs(r->gs), fabs(r->gt)) * k;
+    return nan_max(fabs(r->gs), fabs(r->gt)) * k;
 }
 
 bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_geom_world, SmapReceiver *r)
@@ -131,7 +167,7 @@ bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_g
      * it must tolerate grows with it (catalogue ch.4: ~K texel tan(theta)). */
     double reach = 1.0 + b->filter_radius;
     double slope_max = b->slope_max_texels * r->texel_world * to_stored * reach;
-    double slope = plane ? fmin(b->slope * depth_slope(r) * reach, slope_max) : b->slope > 0.0 ? slope_max : 0.0;
+    double slope = plane ? nan_min(b->slope * depth_slope(r) * reach, slope_max) : b->slope > 0.0 ? slope_max : 0.0;
     double constant = (b->constant_world + b->steps * depth_step_world(m, &r->mc, ndc_per_world)) * to_stored;
     r->bias = constant + slope;
     r->ref = stored_depth(m, &r->mc) - r->bias;

@@ -6,9 +6,11 @@
  * when the receiver-plane bias is on.
  *
  * A technique's table starts with SMAP_MAP_PARAMS then SMAP_BIAS_PARAMS;
- * its own parameters follow at index SMAP_NUM_PARAMS. */
+ * its own parameters follow at index SMAP_NUM_PARAMS (SMAP_DEPTH_BIAS_PARAMS:
+ * at SMAP_NUM_DEPTH_BIAS_PARAMS). */
 #ifndef SL_SMAP_H
 #define SL_SMAP_H
+#include "core/nanmath.h"
 #include "resources/shadowmap.h"
 #include "techniques/technique.h"
 
@@ -108,7 +110,13 @@ extern const char *const smap_select_names[];
 /* The same with the receiver-plane bias on (1) or off (0) by default: wide
  * kernels (blocker searches, soft-shadow filters) need it on, or every planar
  * receiver tilted to the light shadows itself (course §5.2.2.1, its third issue). */
-#define SMAP_BIAS_PARAMS_PLANE(receiver_plane_default)                                                             \
+#define SMAP_BIAS_PARAMS_PLANE(receiver_plane_default) \
+    SMAP_DEPTH_BIAS_PARAMS, SMAP_RECEIVER_PLANE_PARAM(receiver_plane_default)
+/* The biases of the one reference depth a sample is compared with. A
+ * technique that compares a whole prefiltered window with that one depth
+ * (filtered.h: vsm, lvsm, evsm, msm, csm) takes only these: the receiver
+ * plane, a depth per texel, cannot act there. */
+#define SMAP_DEPTH_BIAS_PARAMS                                                                                     \
     {"bias", PARAM_FLOAT, 0, 0, 1e6, "world units", "constant depth bias along the light's depth axis", NULL},      \
     {"bias_steps", PARAM_FLOAT, 0, 0, 1e9, "depth steps",                                                            \
      "constant bias in steps of the stored depth format at the receiver (glPolygonOffset's units)", NULL},          \
@@ -121,8 +129,9 @@ extern const char *const smap_select_names[];
      "times 1 + a filter's radius",                                                                                \
      NULL},                                                                                                        \
     {"normal_offset", PARAM_FLOAT, 0, 0, 100, "texels",                                                              \
-     "normal-offset bias: the lookup point moves along the geometric normal by this many texel widths", NULL},     \
-    {"receiver_plane", PARAM_BOOL, receiver_plane_default, 0, 1, "",                                                                      \
+     "normal-offset bias: the lookup point moves along the geometric normal by this many texel widths", NULL}
+#define SMAP_RECEIVER_PLANE_PARAM(receiver_plane_default)                                                          \
+    {"receiver_plane", PARAM_BOOL, receiver_plane_default, 0, 1, "",                                                 \
      "receiver-plane depth bias (Schueler 2006, course §4.1.2 box): each texel is compared with the receiver's "   \
      "plane at that texel's centre, not with the sample's own depth",                                              \
      NULL}
@@ -135,6 +144,12 @@ enum {
     SMAP_P_BIAS, SMAP_P_BIAS_STEPS, SMAP_P_SLOPE_BIAS, SMAP_P_SLOPE_MAX, SMAP_P_NORMAL_OFFSET, SMAP_P_RECEIVER_PLANE,
     SMAP_NUM_PARAMS
 };
+/* Tables with SMAP_DEPTH_BIAS_PARAMS only: their own parameters start here. */
+#define SMAP_NUM_DEPTH_BIAS_PARAMS SMAP_P_RECEIVER_PLANE
+
+/* When the shared map parameters act (technique.h's ParamCondition), for
+ * every technique whose table starts with SMAP_MAP_PARAMS; ended by {NULL}. */
+extern const ParamCondition smap_conditions[];
 
 /* The map resource the parameters ask for (first layer, no culling). */
 ShadowMapSpec smap_spec(const double *params);
@@ -149,7 +164,10 @@ typedef struct SmapBias {
     float scene_extent;   /* for the engine's own offset, rt_ray_offset */
     double filter_radius; /* texels from the sample to a filter's farthest tap (0: one texel) */
 } SmapBias;
+/* The biases of a table with SMAP_BIAS_PARAMS (receiver plane included). */
 SmapBias smap_bias(const double *params, const Scene *scene);
+/* The same for a table with SMAP_DEPTH_BIAS_PARAMS: no receiver plane. */
+SmapBias smap_depth_bias(const double *params, const Scene *scene);
 
 /* A view sample as the map sees it. */
 typedef struct SmapReceiver {
@@ -181,10 +199,16 @@ static inline double smap_ref_at(const SmapReceiver *r, int i, int j)
 }
 
 /* The shadow test of course §2.1: lit (1) unless the reference lies behind
- * the stored depth; ties are lit. */
+ * the stored depth; ties are lit; NaN when either depth is NaN (unknown,
+ * neither lit nor shadowed: it reaches the output, issue 13 §1). */
+static inline float smap_test(double ref, double stored)
+{
+    return ref > stored ? 0.0f : ref <= stored ? 1.0f : NAN;
+}
+
 static inline float smap_lit(const ShadowMap *m, const SmapReceiver *r, int i, int j)
 {
-    return smap_ref_at(r, i, j) > shadowmap_texel(m, r->mc.face, i, j) ? 0.0f : 1.0f;
+    return smap_test(smap_ref_at(r, i, j), shadowmap_texel(m, r->mc.face, i, j));
 }
 
 /* A stored depth of a face as linear depth (world units along the face's

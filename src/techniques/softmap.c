@@ -83,8 +83,8 @@ bool softmap_may_block(const SoftMap *sm, const SmapReceiver *r, int i0, int j0,
     float zmin, zmax;
     minmax_query(sm->pyramid, r->mc.face, i0, j0, i1, j1, &zmin, &zmax);
     if (z_min_linear) *z_min_linear = smap_linear_depth(sm->map, r->mc.face, zmin);
-    double ref = fmax(fmax(smap_ref_at(r, i0, j0), smap_ref_at(r, i1, j0)),
-                      fmax(smap_ref_at(r, i0, j1), smap_ref_at(r, i1, j1)));
+    double ref = nan_max(nan_max(smap_ref_at(r, i0, j0), smap_ref_at(r, i1, j0)),
+                         nan_max(smap_ref_at(r, i0, j1), smap_ref_at(r, i1, j1)));
     return !(zmin >= ref); /* NaN-safe: an unknown reference may block */
 }
 

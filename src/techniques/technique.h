@@ -23,6 +23,17 @@ typedef struct ParamDesc {
 
 #define TECH_MAX_PARAMS 64
 
+/* When a parameter acts, read against the technique's own values: outside
+ * it the parameter changes nothing, so `list` and the docs print it and the
+ * configuration key leaves the parameter out (registry.h). `when` holds
+ * alternatives joined by " or ", each clauses joined by " and ", each clause
+ * NAME=V or NAME!=V with V one value or several joined by '|' (enum names,
+ * true/false, numbers), e.g. "sampling=poisson|regular". */
+typedef struct ParamCondition {
+    const char *param;
+    const char *when;
+} ParamCondition;
+
 /* Light kinds a technique handles, as a bit set of LightKind. */
 #define LIGHT_BIT(kind) (1u << (kind))
 #define LIGHTS_DELTA (LIGHT_BIT(LIGHT_POINT) | LIGHT_BIT(LIGHT_SPOT) | LIGHT_BIT(LIGHT_DIRECTIONAL))
@@ -57,6 +68,10 @@ typedef struct Technique {
     bool rgb;                    /* evaluates 3 channels when ctx->channels == 3 */
     unsigned lights;             /* LIGHT_BIT set of the light kinds it handles; others are refused */
     const char *main_param;      /* the knob sweeps vary first (a kernel, layers, terms); NULL: none */
+    /* Parameters that act only under a condition, ended by {NULL, NULL};
+     * NULL: none. The shared map parameters' own (smap.h) apply to every
+     * technique whose table starts with them. */
+    const ParamCondition *conditions;
     /* Acquire resources and build per-run state (may be NULL on success). */
     bool (*prepare)(const TechContext *ctx, void **state, Error *err);
     /* Visibility of samples [begin, end) into out[(s - begin) * channels + c];

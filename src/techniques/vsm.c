@@ -25,7 +25,7 @@ typedef enum MomentMethod { METHOD_VSM, METHOD_LVSM, METHOD_EVSM, METHOD_MSM } M
 
 enum { VSM_P_MIN_VAR = FILTER_NUM_PARAMS, VSM_P_BLEED, VSM_P_SLOPE };
 static const ParamDesc vsm_params[] = {
-    SMAP_MAP_PARAMS, SMAP_BIAS_PARAMS, FILTER_PARAMS(PREFILTER_SAT), MIN_VARIANCE_PARAM, BLEED_PARAM,
+    SMAP_MAP_PARAMS, SMAP_DEPTH_BIAS_PARAMS, FILTER_PARAMS(PREFILTER_SAT), MIN_VARIANCE_PARAM, BLEED_PARAM,
     {"slope_moment", PARAM_BOOL, 0, 0, 1, "",
      "Lauritzen 2007 (course §4.2.1 box): add (ddx^2 + ddy^2) / 4 of the depth to M2, the variance of a plane "
      "over the texel (less acne on slopes)",
@@ -36,7 +36,7 @@ FILTER_CHECK_TABLE(vsm_params);
 enum { LVSM_P_LAYERS = FILTER_NUM_PARAMS, LVSM_P_MIN_VAR, LVSM_P_BLEED };
 #define LVSM_MAX_LAYERS 16
 static const ParamDesc lvsm_params[] = {
-    SMAP_MAP_PARAMS, SMAP_BIAS_PARAMS, FILTER_PARAMS(PREFILTER_SAT),
+    SMAP_MAP_PARAMS, SMAP_DEPTH_BIAS_PARAMS, FILTER_PARAMS(PREFILTER_SAT),
     {"layers", PARAM_INT, 4, 1, LVSM_MAX_LAYERS, "layers",
      "uniform depth layers over the map's depth range, two moments each (1 is plain VSM)", NULL},
     MIN_VARIANCE_PARAM, BLEED_PARAM,
@@ -48,7 +48,7 @@ enum { EVSM_P_WARPS = FILTER_NUM_PARAMS, EVSM_P_CPOS, EVSM_P_CNEG, EVSM_P_MIN_VA
 /* Box by default: a SAT's window sums carry an absolute error of about eps
  * times the face's total, while e^(c+ (u - 1)) spans e^-c+ (see prefilter.h). */
 static const ParamDesc evsm_params[] = {
-    SMAP_MAP_PARAMS, SMAP_BIAS_PARAMS, FILTER_PARAMS(PREFILTER_BOX),
+    SMAP_MAP_PARAMS, SMAP_DEPTH_BIAS_PARAMS, FILTER_PARAMS(PREFILTER_BOX),
     {"warps", PARAM_ENUM, 1, 0, 1, "",
      "positive: exp(c+ u) and its square (2 components); both: also -exp(-c- u) and its square (4 components), "
      "the result the smaller bound",
@@ -66,7 +66,7 @@ FILTER_CHECK_TABLE(evsm_params);
 
 enum { MSM_P_BIAS = FILTER_NUM_PARAMS };
 static const ParamDesc msm_params[] = {
-    SMAP_MAP_PARAMS, SMAP_BIAS_PARAMS, FILTER_PARAMS(PREFILTER_SAT),
+    SMAP_MAP_PARAMS, SMAP_DEPTH_BIAS_PARAMS, FILTER_PARAMS(PREFILTER_SAT),
     {"moment_bias", PARAM_FLOAT, 3e-5, 0, 1, "",
      "alpha of b' = (1 - alpha) b + alpha (0, 0.63, 0, 0.63): keeps the Hankel matrix positive definite against "
      "rounding (Peters & Klein 2015); more bias, more light leaking; 1 ignores the map",
@@ -139,6 +139,7 @@ static bool msm_prepare(const TechContext *ctx, void **state, Error *err)
  * phi_i(u); the warp stretches depth by L, so the variance clamp by L^2. */
 static double lvsm_lit(const MomentState *st, const double *m, double u)
 {
+    if (isnan(u)) return NAN; /* no layer to pick */
     int L = st->layers, i = (int)(u * L);
     i = i < 0 ? 0 : i >= L ? L - 1 : i;
     double phi = (u - (double)i / L) * L;
@@ -154,7 +155,7 @@ static double evsm_lit(const MomentState *st, const double *m, double u)
     double p = chebyshev_upper(m[0], m[1], wp, st->min_variance * sp * sp);
     if (st->negative) {
         double wn = exp(-st->c_neg * u), sn = st->c_neg * wn;
-        p = fmin(p, chebyshev_upper(m[2], m[3], -wn, st->min_variance * sn * sn));
+        p = nan_min(p, chebyshev_upper(m[2], m[3], -wn, st->min_variance * sn * sn));
     }
     return p;
 }
@@ -170,6 +171,8 @@ static double evsm_lit(const MomentState *st, const double *m, double u)
 static double msm_lit(const double *b_in, double zf, double alpha)
 {
     static const double b_bias[4] = {0.0, 0.63, 0.0, 0.63};
+    /* A NaN moment would vanish in the pivots' clamps below (fmax(NaN, eps) = eps). */
+    if (isnan(b_in[0] + b_in[1] + b_in[2] + b_in[3] + zf)) return NAN;
     double b[4];
     for (int k = 0; k < 4; k++) b[k] = (1.0 - alpha) * b_in[k] + alpha * b_bias[k];
     double l21 = b[0], l31 = b[1];
@@ -214,21 +217,24 @@ static void moment_evaluate(const void *state, const TechContext *ctx, int begin
     }
 }
 
-#define MOMENT_TECHNIQUE(var, tname, tsource, tsummary, table, prep, tmain)                                        \
+#define MOMENT_TECHNIQUE(var, tname, tsource, tsummary, table, prep, tmain, tconditions)                           \
     const Technique var = {.name = tname, .family = "filtered", .source = tsource, .summary = tsummary,           \
                            .params = table, .num_params = (int)(sizeof table / sizeof table[0]),                \
                            .resources = filter_resources, .rgb = false, .lights = LIGHTS_ALL, .main_param = tmain, \
-                           .prepare = prep, .evaluate = moment_evaluate, .release = free}
+                           .conditions = tconditions, .prepare = prep, .evaluate = moment_evaluate, .release = free}
+
+/* The negative warp exists only with both warps. */
+static const ParamCondition evsm_conditions[] = {{"exponent_neg", "warps=both"}, {NULL, NULL}};
 
 MOMENT_TECHNIQUE(tech_vsm, "vsm", "course §4.2.1 (Eq. 4.2; Donnelly & Lauritzen 2006), §4.2.2 bleeding reduction",
                  "variance shadow map: Chebyshev's upper bound from the prefiltered z and z^2", vsm_params,
-                 vsm_prepare, "K");
+                 vsm_prepare, "K", NULL);
 MOMENT_TECHNIQUE(tech_lvsm, "lvsm", "course §4.2.2 (Lauritzen & McCool 2008)",
                  "layered variance shadow map: the Chebyshev bound within the receiver's depth layer", lvsm_params,
-                 lvsm_prepare, "layers");
+                 lvsm_prepare, "layers", NULL);
 MOMENT_TECHNIQUE(tech_evsm, "evsm", "course §4.2.4 'EVSM' (Lauritzen & McCool 2008; warp pair erratum)",
                  "exponential variance shadow map: Chebyshev on exp(c+ z) and -exp(-c- z), the smaller bound",
-                 evsm_params, evsm_prepare, "K");
+                 evsm_params, evsm_prepare, "K", evsm_conditions);
 MOMENT_TECHNIQUE(tech_msm, "msm", "Peters & Klein 2015, Algorithm 2 (Hamburger 4MSM); not in the course",
                  "moment shadow map: the sharpest lower bound on the shadow from four prefiltered moments",
-                 msm_params, msm_prepare, "K");
+                 msm_params, msm_prepare, "K", NULL);

@@ -77,6 +77,8 @@ expect runtime_light_out_of_range 1 "--light 3 outside \[1, 1\]" -- "$SL" render
 expect help_compare 0 "--samples" "--repeat" -- "$SL" compare --help
 expect help_reference 0 "--samples" "--measure" -- "$SL" reference --help
 expect list_shows_hard 0 "hard" "offset_scale" "course" -- "$SL" list
+expect list_shows_when_a_parameter_acts 0 "acts" "kernel=poisson" -- "$SL" list
+expect usage_vsm_takes_no_receiver_plane 2 "unknown parameter 'receiver_plane'" -- "$SL" render "$SCENE" -t vsm -p receiver_plane=true
 
 "$SL" list --json >"$TMP/list.json" 2>"$TMP/err"
 if command -v python3 >/dev/null && python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert any(t["name"]=="hard" for t in d)' "$TMP/list.json" 2>>"$TMP/err"; then

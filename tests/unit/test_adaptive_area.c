@@ -208,10 +208,10 @@ TEST(test_adaptive_area_contact_is_finite_for_extreme_parameters)
     const Technique *t = tech_find("adaptive_area", &err);
     double p[TECH_MAX_PARAMS];
     tech_params_default(t, p);
-    /* the declared range is one plain perspective map: refused when set, naming what it accepts */
+    /* the declared range is one plain perspective map (auto): refused when set, naming what it accepts */
     CHECK(!tech_param_parse(t, "projection=cube", p, &err));
     printf("    cube map refused: %s\n", err.msg);
-    CHECK(strstr(err.msg, "projection = cube") && strstr(err.msg, "one of: auto, perspective"));
+    CHECK(strstr(err.msg, "projection = cube") && strstr(err.msg, "one of: auto"));
     p[SMAP_P_PROJECTION] = MAP_PROJ_CUBE; /* also when handed raw to lab_render */
     RenderRequest rq = {.tech = t, .params = p, .light_index = 0, .repeat = 1};
     RenderResult r;

@@ -41,6 +41,7 @@ TEST(test_registry_refuses_bad_values_with_the_range)
         for (int k = 0; k < t->num_params; k++) {
             const ParamDesc *p = &t->params[k];
             char assign[256], range[256];
+            if (!tech_param_offered(t, k)) continue; /* refused by name: test_registry_conditions_are_well_formed */
             tech_param_range(p, range, sizeof range);
             snprintf(assign, sizeof assign, "%s=%.17g", p->name, p->max + 1.0);
             CHECK_MSG(!tech_param_parse(t, assign, v, &err), "%s accepted", assign);
@@ -58,4 +59,41 @@ TEST(test_registry_refuses_bad_values_with_the_range)
             CHECK(v[k] == p->def);
         }
     }
+}
+
+/* Every declared condition (Technique.conditions, smap_conditions) parses,
+ * names parameters of its technique and parses their values; a condition
+ * holds once tech_param_enable has set what it names. */
+TEST(test_registry_conditions_are_well_formed)
+{
+    for (int i = 0; i < tech_count(); i++) {
+        const Technique *t = tech_at(i);
+        for (const ParamCondition *c = t->conditions; c && c->param; c++)
+            CHECK_MSG(tech_param_index(t, c->param) >= 0, "%s: condition for unknown parameter %s", t->name, c->param);
+        for (int k = 0; k < t->num_params; k++) {
+            Error err;
+            CHECK_MSG(tech_param_condition_check(t, k, &err), "%s", err.msg);
+            if (!tech_param_offered(t, k)) continue;
+            double v[TECH_MAX_PARAMS];
+            tech_params_default(t, v);
+            tech_param_enable(t, k, v);
+            CHECK_MSG(tech_param_acts(t, k, v), "%s.%s: its condition '%s' does not hold once enabled", t->name,
+                      t->params[k].name, tech_param_when(t, k));
+            CHECK_MSG(tech_params_check(t, v, &err), "%s.%s enabled: %s", t->name, t->params[k].name, err.msg);
+        }
+    }
+    Error err;
+    const Technique *pcss = tech_find("pcss", &err);
+    double v[TECH_MAX_PARAMS];
+    tech_params_default(pcss, v);
+    int taps = tech_param_index(pcss, "blocker_taps");
+    CHECK(tech_param_acts(pcss, taps, v));
+    CHECK(tech_param_parse(pcss, "sampling=exhaustive", v, &err));
+    CHECK(!tech_param_acts(pcss, taps, v));
+    /* a shared parameter whose condition cannot hold in the technique is not its own */
+    const Technique *aa = tech_find("adaptive_area", &err);
+    CHECK(!tech_param_offered(aa, tech_param_index(aa, "warp_n")));
+    CHECK(!tech_param_parse(aa, "warp_n=2", v, &err));
+    CHECK_MSG(strstr(err.msg, "warp_n") && strstr(err.msg, "projection=lispsm"), "%s", err.msg);
+    CHECK_MSG(tech_param_parse(aa, "warp_n=1", v, &err), "its default, as a record names it: %s", err.msg);
 }
