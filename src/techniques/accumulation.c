@@ -46,7 +46,7 @@ enum { P_K = SMAP_NUM_PARAMS, P_VARIANT, P_GRID };
 #define ACC_MAX_K 64 /* a kernel row is one 64-bit word of occlusion bits */
 
 static const ParamDesc acc_params[] = {
-    SMAP_MAP_PARAMS,
+    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_CUBE, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT),
     SMAP_BIAS_PARAMS_PLANE(1),
     {"K", PARAM_INT, 10, 1, ACC_MAX_K, "lexels",
      "kernel size: the K x K lexels visited around the receiver's own (seed 000 §1.1: 5 for speed, 10 \"good for "
@@ -329,7 +329,9 @@ static float visibility(const AccState *st, const SmapReceiver *r, int *level)
     if (fr.n > 0.0) {
         *level = fr.level;
         int s = fr.scale, i1 = (fr.i0 + st->K) * s - 1, j1 = (fr.j0 + st->K) * s - 1;
-        if (!softmap_may_block(&st->sm, r, fr.i0 * s, fr.j0 * s, i1, j1, NULL)) return 1.0f;
+        double z_min;
+        if (!softmap_may_block(&st->sm, r, fr.i0 * s, fr.j0 * s, i1, j1, &z_min)) return 1.0f;
+        if (isnan(z_min)) return NAN; /* a NaN depth in the kernel (the pyramid keeps it): unknown, issue 13 §1 */
         if (st->variant == VARIANT_ADDITIVE) return (float)(1.0 - shadow_additive(st, r, &fr));
         bool empty;
         double v = 1.0 - shadow_obits(st, r, &fr, &empty);

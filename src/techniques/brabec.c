@@ -24,6 +24,7 @@
  * object casts on itself (the bunny's umbra leaked 0.44, the teapot's 0.11;
  * issue 13). */
 #include <stdlib.h>
+#include "core/nanmath.h"
 #include "techniques/softmap.h"
 
 enum { FALLOFF_SMOOTH, FALLOFF_LINEAR };
@@ -34,7 +35,7 @@ enum { P_SEARCH = SMAP_NUM_PARAMS, P_FALLOFF, P_SELF_SHADOW };
 #define BRABEC_MAX_SEARCH 64
 
 static const ParamDesc brabec_params[] = {
-    SMAP_MAP_PARAMS,
+    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_CUBE, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT),
     SMAP_BIAS_PARAMS_PLANE(1),
     {"search_radius", PARAM_INT, 32, 1, BRABEC_MAX_SEARCH, "texels",
      "radius of the neighbourhood searched for the nearest blocked (or unblocked) texel", NULL},
@@ -153,7 +154,7 @@ static double half_width(double a, double z_p, double z_b) { return a * (z_p - z
 /* The nearest texel whose blocked state is `want`, its centre within
  * `limit` (tangent units) of p's own texel's; its distance from p to the
  * texels' shared edge (half a texel before its centre) in *edge, the texel
- * in *i, *j. */
+ * in *i, *j. A NaN depth met first makes *edge NaN (the answer is unknown). */
 static bool nearest(const BrabecState *st, const SmapReceiver *r, int object, bool want, double limit, double *edge,
                     int *i, int *j)
 {
@@ -163,6 +164,10 @@ static bool nearest(const BrabecState *st, const SmapReceiver *r, int object, bo
     double half_texel = 0.5 * fmin(f->dx, f->dy);
     for (int k = 0; k < st->num_offsets && st->offsets[k].dist <= limit; k++) {
         int ii = i0 + st->offsets[k].di, jj = j0 + st->offsets[k].dj;
+        if (isnan(shadowmap_texel(st->sm.map, r->mc.face, ii, jj))) { /* unknown before any answer: NaN */
+            *edge = NAN;
+            return true;
+        }
         if (blocked(st, r, object, ii, jj) != want) continue;
         *edge = fmax(0.0, hypot(softmap_di(r, ii) * f->dx, softmap_dj(r, jj) * f->dy) - half_texel);
         *i = ii;
@@ -198,7 +203,7 @@ static bool outer_limit(const BrabecState *st, const SmapReceiver *r, double a, 
         int ri = (int)ceil(*limit / f->dx), rj = (int)ceil(*limit / f->dy); /* the offsets nearest() may visit */
         double z_min;
         if (!softmap_may_block(&st->sm, r, i - ri, j - rj, i + ri, j + rj, &z_min)) return false;
-        z_near = fmax(z_near, z_min);
+        z_near = nan_max(z_near, z_min); /* NaN in reach: a NaN limit, so a NaN visibility */
     }
     return true;
 }
@@ -218,21 +223,26 @@ static float visibility(const BrabecState *st, const SmapReceiver *r, int object
     double a = f->light.radius_world, z_p = r->mc.depth_linear, z_n = f->near_world, edge;
     int i, j;
     smap_texel(r, &i, &j);
+    if (isnan(shadowmap_texel(st->sm.map, r->mc.face, i, j))) return NAN; /* the receiver's own texel: unknown */
     if (!blocked(st, r, object, i, j)) { /* outer penumbra: the nearest blocker */
         double limit;
-        if (!outer_limit(st, r, a, &limit) || !nearest(st, r, object, true, limit, &edge, &i, &j)) return 1.0f;
-        double w = half_width(a, z_p, fmax(softmap_depth(&st->sm, r->mc.face, i, j), z_n));
+        if (!outer_limit(st, r, a, &limit)) return 1.0f;
+        if (isnan(limit)) return NAN;
+        if (!nearest(st, r, object, true, limit, &edge, &i, &j)) return 1.0f;
+        if (isnan(edge)) return NAN;
+        double w = half_width(a, z_p, nan_max(softmap_depth(&st->sm, r->mc.face, i, j), z_n));
         return w > 0.0 ? (float)falloff(st->falloff, 0.5 + edge / (2.0 * w)) : 1.0f;
     }
     /* inner penumbra: the nearest unblocked texel is the place; the blocker at
      * that edge, the blocked texel next to it on p's side, sets the width */
-    double w = half_width(a, z_p, fmax(softmap_depth(&st->sm, r->mc.face, i, j), z_n));
+    double w = half_width(a, z_p, nan_max(softmap_depth(&st->sm, r->mc.face, i, j), z_n));
     double limit = fmin(w, st->search_tangent) + search_slack(f);
     int i0 = i, j0 = j;
     if (!(w > 0.0) || !nearest(st, r, object, false, limit, &edge, &i, &j)) return 0.0f;
+    if (isnan(edge)) return NAN;
     int ei, ej;
     edge_blocker(i, j, i0, j0, &ei, &ej);
-    double w_edge = half_width(a, z_p, fmax(softmap_depth(&st->sm, r->mc.face, ei, ej), z_n));
+    double w_edge = half_width(a, z_p, nan_max(softmap_depth(&st->sm, r->mc.face, ei, ej), z_n));
     return w_edge > 0.0 ? (float)falloff(st->falloff, 0.5 - edge / (2.0 * w_edge)) : 0.0f;
 }
 
