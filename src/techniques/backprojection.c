@@ -167,15 +167,11 @@ static int budget_level(const BpState *st, int wi, int wj)
 static void load_window(const BpState *st, const SmapReceiver *r, int wi, int wj, Window *w)
 {
     const SoftFace *f = &st->sm.face[r->mc.face];
-    int level = budget_level(st, wi, wj), scale = 1 << level, size = st->sm.pyramid->size[level];
+    int level = budget_level(st, wi, wj), scale = 1 << level;
     int i, j;
     smap_texel(r, &i, &j);
     int i0 = (int)floor((double)(i - wi) / scale), i1 = (int)floor((double)(i + wi) / scale);
     int j0 = (int)floor((double)(j - wj) / scale), j1 = (int)floor((double)(j + wj) / scale);
-    i0 = i0 > 0 ? i0 : 0; /* lexels off the face hold nothing known: only the border reads them (+INFINITY) */
-    j0 = j0 > 0 ? j0 : 0;
-    i1 = i1 < size - 1 ? i1 : size - 1;
-    j1 = j1 < size - 1 ? j1 : size - 1;
     w->level = level;
     w->i0 = i0 - 1;
     w->j0 = j0 - 1;
@@ -190,9 +186,8 @@ static void load_window(const BpState *st, const SmapReceiver *r, int wi, int wj
     w->p_z = r->mc.depth_linear;
     for (int b = 0; b < w->h; b++)
         for (int a = 0; a < w->w; a++) {
-            int li = w->i0 + a, lj = w->j0 + b, ti = li, tj = lj;
+            int ti = w->i0 + a, tj = w->j0 + b; /* off the face: edge-clamped, as every window of the map */
             w->z[b][a] = INFINITY;
-            if (li < 0 || lj < 0 || li >= size || lj >= size) continue; /* outside the face: nothing known */
             float stored = minmax_node_min(st->sm.pyramid, r->mc.face, level, &ti, &tj);
             if (smap_ref_at(r, ti, tj) > stored) /* NaN: not a caster */
                 w->z[b][a] = smap_linear_depth(st->sm.map, r->mc.face, stored);
