@@ -22,6 +22,7 @@ extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
 extern const Technique tech_aliasing;
 extern const Technique tech_backprojection;
+extern const Technique tech_light_sampling;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -41,6 +42,7 @@ static const Technique *const registry[] = {
     &tech_shadow_width,
     &tech_aliasing,
     &tech_backprojection,
+    &tech_light_sampling,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }

@@ -285,3 +285,61 @@ TEST(test_backprojection_receivers_at_the_lights_depth_stay_finite)
     }
     lab_close(lab);
 }
+
+/* light_sampling (course §5.2.4) on the parallel square: the penumbra RMSE
+ * against the closed form (no reference noise) for N = 1, 4, 16, 64 maps
+ * (512^2, the R2 pattern) falls as 1/sqrt(N) or faster: its log-log slope
+ * is at most -1/2 and each sixteenfold N at least quarters it (fourfold
+ * steps alone are not monotone in rate: R2's first 16 points are no better
+ * spread in x than its first 4 by a factor 2). A random pattern converges
+ * too (each sixteenfold N at least halves it, one realisation). */
+static double ls_penumbra_rmse(Lab *lab, const char *samples, const char *pattern)
+{
+    Error err;
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    const char *p[] = {"map_size=512", samples, pattern, NULL};
+    RenderResult r;
+    if (!vs || !cls || !soft_render(lab, "light_sampling", p, &r)) return NAN;
+    double sum = 0;
+    long n = 0;
+    for (int s = 0; s < vs->count; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE || vs->object[s] != 0) continue;
+        double exact = square_exact(vs->p_world[s]), e = r.visibility.data[s] - exact;
+        if (!(exact > 0.01 && exact < 0.99)) continue;
+        sum += e * e;
+        n++;
+    }
+    render_result_free(&r);
+    return n > 500 ? sqrt(sum / n) : NAN;
+}
+
+TEST(test_light_sampling_converges_as_one_over_sqrt_n)
+{
+    Lab *lab = fixture_lab("square.lua", square_scene);
+    CHECK(lab);
+    static const char *const counts[] = {"samples=1", "samples=4", "samples=16", "samples=64"};
+    double r2[4], rnd[4];
+    for (int k = 0; k < 4; k++) {
+        r2[k] = ls_penumbra_rmse(lab, counts[k], "pattern=r2");
+        rnd[k] = ls_penumbra_rmse(lab, counts[k], "pattern=random");
+        printf("    %-10s penumbra RMSE r2 %.4f, random %.4f\n", counts[k], r2[k], rnd[k]);
+        CHECK(isfinite(r2[k]) && isfinite(rnd[k]));
+    }
+    /* least-squares slope of log RMSE against log N */
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int k = 0; k < 4; k++) {
+        double x = log(pow(4.0, k)), y = log(r2[k]);
+        sx += x, sy += y, sxx += x * x, sxy += x * y;
+    }
+    double slope = (4 * sxy - sx * sy) / (4 * sxx - sx * sx);
+    printf("    r2: RMSE ~ N^%.2f\n", slope);
+    CHECK_MSG(slope <= -0.5, "r2: RMSE falls as N^%.2f, slower than 1/sqrt(N)", slope);
+    for (int k = 2; k < 4; k++) {
+        CHECK_MSG(r2[k] <= 0.25 * r2[k - 2], "r2: %s RMSE %.4f above a quarter of N/16's %.4f", counts[k], r2[k],
+                  r2[k - 2]);
+        CHECK_MSG(rnd[k] <= 0.5 * rnd[k - 2], "random: %s RMSE %.4f above half of N/16's %.4f", counts[k], rnd[k],
+                  rnd[k - 2]);
+    }
+    lab_close(lab);
+}
