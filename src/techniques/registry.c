@@ -23,6 +23,7 @@ extern const Technique tech_shadow_width;
 extern const Technique tech_aliasing;
 extern const Technique tech_backprojection;
 extern const Technique tech_light_sampling;
+extern const Technique tech_occlusion_textures;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -43,6 +44,7 @@ static const Technique *const registry[] = {
     &tech_aliasing,
     &tech_backprojection,
     &tech_light_sampling,
+    &tech_occlusion_textures,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }
