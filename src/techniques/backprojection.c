@@ -208,8 +208,9 @@ static bool poly_contains(const Poly *p, double x, double y)
     return in;
 }
 
-/* Mark the samples the polygon covers (rect: an axis-aligned box, n = 0,
- * corners (x[0], y[0]) and (x[1], y[1])); returns how many it marked. */
+/* Mark the samples the polygon covers in mask (NULL: count only; rect: an
+ * axis-aligned box, corners (x[0], y[0]) and (x[1], y[1])); returns how
+ * many it covers. */
 static int cover(const FaceSamples *fs, const Poly *p, bool rect, uint64_t *mask)
 {
     double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
@@ -230,7 +231,7 @@ static int cover(const FaceSamples *fs, const Poly *p, bool rect, uint64_t *mask
             double x = fs->x[s], y = fs->y[s];
             bool in = rect ? x >= xlo && x < xhi && y >= ylo && y < yhi : poly_contains(p, x, y);
             if (!in) continue;
-            mask[s >> 6] |= 1ull << (s & 63);
+            if (mask) mask[s >> 6] |= 1ull << (s & 63);
             marked++;
         }
     return marked;
@@ -293,8 +294,7 @@ static double window_visibility(const BpState *st, const FaceSamples *fs, const 
             Poly p = {.n = 0};
             bool ok = patch ? isfinite(win_z(w, a, b)) && micropatch(st, w, a, b, &p) : microquad(st, w, a, b, &p);
             if (!ok) continue;
-            uint64_t own[BP_WORDS]; /* area: each occluder's own samples, counted, not united */
-            sum += cover(fs, &p, patch, st->accumulate == ACC_AREA ? own : mask);
+            sum += cover(fs, &p, patch, st->accumulate == ACC_AREA ? NULL : mask); /* area: counted, not united */
         }
     if (st->accumulate == ACC_AREA) return sum >= st->samples ? 0.0 : 1.0 - (double)sum / st->samples;
     int marked = 0;
