@@ -107,40 +107,12 @@ typedef struct Frame {
     int i0, j0;
 } Frame;
 
-/* Half-width (tangent units) of the light's footprint, seen from a receiver
- * at depth r_z, on the casters at depth z: half_world (r_z - z) / (r_z z),
- * the similar triangles of backproject_plane with n = z (and of PCSS's
- * search area, course §5.2.2). */
-static double footprint(double half_world, double r_z, double z) { return half_world * (r_z - z) / (r_z * z); }
-
-/* The nearest depth a blocker of r can have (world units): the face's near
- * plane, narrowed twice through the pyramid's minimum over the texels the
- * light's footprint from there spans (course §5.2.3.4's search area through
- * z_min, as brabec's outer search). false: nothing in reach can block r. */
-static bool nearest_blocker(const AccState *st, const SmapReceiver *r, double *z_b)
-{
-    const SoftFace *f = &st->sm.face[r->mc.face];
-    double r_z = r->mc.depth_linear;
-    int i, j;
-    smap_texel(r, &i, &j);
-    *z_b = f->near_world;
-    for (int pass = 0; pass < 3 && *z_b < r_z; pass++) {
-        double ri = ceil(footprint(f->light.half_x, r_z, *z_b) / f->dx) + 1.0;
-        double rj = ceil(footprint(f->light.half_y, r_z, *z_b) / f->dy) + 1.0;
-        int wi = (int)fmin(ri, st->sm.map->res), wj = (int)fmin(rj, st->sm.map->res); /* NaN: 0, the own texel */
-        double z_min;
-        if (!softmap_may_block(&st->sm, r, i - wi, j - wj, i + wi, j + wj, &z_min)) return false;
-        if (z_min > *z_b) *z_b = z_min;
-    }
-    return true;
-}
-
 /* The first level whose K lexels span the footprint from blockers at z_b
  * along both axes (K 2^L dx / 2 >= footprint), the pyramid's top at most. */
 static int footprint_level(const AccState *st, const SoftFace *f, double r_z, double z_b)
 {
-    double texels = 2.0 / st->K * fmax(footprint(f->light.half_x, r_z, z_b) / f->dx,
-                                       footprint(f->light.half_y, r_z, z_b) / f->dy);
+    double texels = 2.0 / st->K * fmax(backproject_footprint(f->light.half_x, r_z, z_b) / f->dx,
+                                       backproject_footprint(f->light.half_y, r_z, z_b) / f->dy);
     int level = 0;
     while (level + 1 < st->sm.pyramid->levels && (double)(1 << level) < texels) level++; /* NaN: level 0 */
     return level;
@@ -303,7 +275,7 @@ static bool footprint_frame(const AccState *st, const SmapReceiver *r, Frame *fr
 {
     const SoftFace *f = &st->sm.face[r->mc.face];
     double z_b;
-    if (!nearest_blocker(st, r, &z_b)) return false;
+    if (!backproject_search(&st->sm, r, &z_b)) return false;
     int level = footprint_level(st, f, r->mc.depth_linear, z_b);
     for (int pass = 0; pass < 2; pass++) {
         if (!frame(st, r, level, fr) || !nearest_caster(st, r, fr, &z_b)) return true;

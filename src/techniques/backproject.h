@@ -14,6 +14,7 @@
 #define SL_BACKPROJECT_H
 #include <math.h>
 #include <stdbool.h>
+#include "techniques/softmap.h"
 
 /* The stiff case r_z - c_z -> 0 (contact, self-shadowing): a caster at the
  * receiver's depth or behind it cannot lie between r and the light (every
@@ -57,6 +58,101 @@ static inline bool backproject(double r_z, double c_z, double n, double di, doub
 static inline double backproject_plane(double half_world, double r_z, double half_tangent)
 {
     return half_world * r_z / (half_world + r_z * half_tangent);
+}
+
+/* The same projection onto the light's own plane z = 0 (course §5.2.3.1,
+ * [OWN] backprojection: L_xy = (p_z X_xy - z p_xy) / (p_z - z), p the
+ * receiver, X a caster point at depth z). With X = x z and p = u p_z (x, u
+ * tangents of the face) it is L = k (x - u), k = z p_z / (p_z - z): the
+ * caster's tangent offset from the receiver times k (world units on the
+ * light's plane). Singular as z -> p_z: guarded as backproject() is (a
+ * caster at or behind the receiver cannot occlude: false; closer than
+ * BACKPROJECT_MIN_GAP p_z: held there). */
+static inline bool backproject_light_scale(double p_z, double z, double *k)
+{
+    double gap = p_z - z;
+    if (!(gap > 0.0) || !(z > 0.0)) return false;
+    gap = fmax(gap, BACKPROJECT_MIN_GAP * p_z); /* gap > 0 here: no NaN reaches fmax */
+    *k = z * p_z / gap;
+    return true;
+}
+
+/* Half-width (tangent units) of the light's footprint, seen from a receiver
+ * at depth r_z, on the casters at depth z: half_world (r_z - z) / (r_z z),
+ * the similar triangles of backproject_plane with n = z (PCSS's search area,
+ * course §5.2.2; [OWN] width of course §5.2.3.4). */
+static inline double backproject_footprint(double half_world, double r_z, double z)
+{
+    return half_world * (r_z - z) / (r_z * z);
+}
+
+/* Half-widths (texels, level 0) of the footprint at depth z_b, plus one
+ * texel for the receiver's own, at most the map's size (NaN: 0, the own texel). */
+static inline void backproject_search_halfwidth(const SoftMap *sm, const SmapReceiver *r, double z_b, int *wi,
+                                                int *wj)
+{
+    const SoftFace *f = &sm->face[r->mc.face];
+    double r_z = r->mc.depth_linear;
+    double ri = ceil(backproject_footprint(f->light.half_x, r_z, z_b) / f->dx) + 1.0;
+    double rj = ceil(backproject_footprint(f->light.half_y, r_z, z_b) / f->dy) + 1.0;
+    *wi = ri >= 0.0 ? (int)fmin(ri, sm->map->res) : 0; /* NaN compares false: 0 */
+    *wj = rj >= 0.0 ? (int)fmin(rj, sm->map->res) : 0;
+}
+
+/* The search area (course §5.2.3.4, Fig. 5.9): the light's footprint on the
+ * face's near plane, narrowed (three passes) through the plane of the
+ * pyramid's minimum z_min over the texels that footprint spans: no blocker
+ * of r lies nearer the light than *z_b (world units), so the footprint at
+ * *z_b holds every texel that can occlude r. false: nothing in reach can
+ * block r (z_p <= z_min: lit). */
+static inline bool backproject_search(const SoftMap *sm, const SmapReceiver *r, double *z_b)
+{
+    const SoftFace *f = &sm->face[r->mc.face];
+    double r_z = r->mc.depth_linear;
+    int i, j;
+    smap_texel(r, &i, &j);
+    *z_b = f->near_world;
+    for (int pass = 0; pass < 3 && *z_b < r_z; pass++) {
+        int wi, wj;
+        backproject_search_halfwidth(sm, r, *z_b, &wi, &wj);
+        double z_min;
+        if (!softmap_may_block(sm, r, i - wi, j - wj, i + wi, j + wj, &z_min)) return false;
+        if (z_min > *z_b) *z_b = z_min;
+    }
+    return true;
+}
+
+/* Occlusion bitmasks' light samples (Schwarz & Stamminger 2007, course
+ * §5.2.3.2: "256 regularly jittered sample points corresponding to an 8x8
+ * tiling of the 2x2 rotated grid (RGSS) pattern"): sample k of
+ * 4 tiles^2 in [-1, 1]^2, tile k / 4 (row-major), RGSS offset k % 4 within
+ * it (one sample per row and per column quarter of the tile). Disk-shaped
+ * lights (sphere cross-sections, disks) take the square through Shirley &
+ * Chiu's concentric map (1997), which keeps areas, so every sample still
+ * stands for 1/N of the light. The light point is then x = M xi (softmap.h). */
+#define BACKPROJECT_MAX_SAMPLES 1024 /* tiles <= 16 */
+
+static inline void backproject_light_sample(int tiles, int k, bool square, double *x, double *y)
+{
+    static const double rgss[4][2] = {{0.375, 0.125}, {0.875, 0.375}, {0.125, 0.625}, {0.625, 0.875}};
+    int t = k / 4;
+    double a = -1.0 + 2.0 * (t % tiles + rgss[k % 4][0]) / tiles;
+    double b = -1.0 + 2.0 * (t / tiles + rgss[k % 4][1]) / tiles;
+    if (square) {
+        *x = a;
+        *y = b;
+        return;
+    }
+    double r, phi; /* concentric map: the square's rings onto the disk's */
+    if (fabs(a) > fabs(b)) {
+        r = a;
+        phi = M_PI / 4.0 * (b / a);
+    } else {
+        r = b;
+        phi = M_PI / 2.0 - M_PI / 4.0 * (a / b); /* b != 0: the RGSS offsets never hit the centre */
+    }
+    *x = r * cos(phi);
+    *y = r * sin(phi);
 }
 
 #endif

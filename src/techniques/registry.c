@@ -22,6 +22,9 @@ extern const Technique tech_pcss;
 extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
 extern const Technique tech_aliasing;
+extern const Technique tech_backprojection;
+extern const Technique tech_light_sampling;
+extern const Technique tech_occlusion_textures;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -40,6 +43,9 @@ static const Technique *const registry[] = {
     &tech_adaptive_area,
     &tech_shadow_width,
     &tech_aliasing,
+    &tech_backprojection,
+    &tech_light_sampling,
+    &tech_occlusion_textures,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }

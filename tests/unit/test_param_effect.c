@@ -39,6 +39,8 @@ static const struct { const char *param, *settings; } probes[] = {
     {"depth", "depth_bits=u16 slope_bias=0"},
     {"depth_bits", "slope_bias=0"},
     {"depth_bits", "sampling=exhaustive"},
+    {"depth_bits", "depth=ndc"}, /* backprojection, occlusion_textures: linear depth's quantisation is absorbed */
+    {"stabilize", "projection=perspective"}, /* light_sampling: auto gives its point samples cube maps */
     {"split_2", "split_1=2"},
     {"split_3", "split_1=2 split_2=3"},
     {"cascade_select", "cascades=8"},

@@ -1,0 +1,429 @@
+/* test_backprojection.c -- `backprojection` (course §5.2.3.1-3, occlusion
+ * bitmasks §5.2.3.2): the singular backprojection z -> p_z stays finite; for
+ * one planar occluder parallel to a square light the bitmask is exact up to
+ * the sample count (the closed form test_reference.c uses) and matches
+ * Embree traced toward the same light samples wherever a sample's ray
+ * crosses the occluder's plane farther than the map's texel from its edges;
+ * each occluder representation's documented bias is measured (micropatch
+ * over-occlusion, gap leaks without gap filling, summed areas over
+ * overlaps, microquads losing one-texel twigs). 160 x 120 or smaller. */
+#include <math.h>
+#include <stdlib.h>
+#include "fixtures.h"
+#include "resources/standard.h"
+#include "soft_helpers.h"
+#include "techniques/backproject.h"
+#include "test.h"
+
+TEST(test_backprojection_singular_receiver_depth_is_guarded)
+{
+    double k;
+    CHECK(!backproject_light_scale(4.0, 4.0, &k));  /* at the receiver's depth: cannot occlude */
+    CHECK(!backproject_light_scale(4.0, 4.5, &k));  /* behind it */
+    CHECK(!backproject_light_scale(4.0, NAN, &k));
+    CHECK(!backproject_light_scale(NAN, 2.0, &k));
+    CHECK(backproject_light_scale(4.0, nextafter(4.0, 0.0), &k)); /* one ulp in front: held at the gap */
+    CHECK(isfinite(k) && k <= 4.0 * 4.0 / (BACKPROJECT_MIN_GAP * 4.0) * 1.0001);
+    /* the course's L = (p_z X - z p) / (p_z - z) at an ordinary point */
+    double p_z = 4.0, z = 2.5, u = 0.1, x = 0.3;
+    CHECK(backproject_light_scale(p_z, z, &k));
+    CHECK_NEAR(k * (x - u), (p_z * (x * z) - z * (u * p_z)) / (p_z - z), 1e-12);
+}
+
+/* Light: 1 x 1 square at y = 4 facing down; occluder: 0.8 x 0.8 square at
+ * y = 2, parallel to it; ground at y = 0. */
+static const char *const square_scene =
+    "return {\n"
+    "  camera = { position = {0, 5, 3.5}, target = {0, 0, 0}, fov = 40, width = 120, height = 90 },\n"
+    "  lights = { { type = 'rect', position = {0, 4, 0}, direction = {0, -1, 0}, up = {0, 0, 1},\n"
+    "               width = 1, height = 1 } },\n"
+    "  objects = {\n"
+    "    { name = 'ground', shape = 'plane', size = {6, 6} },\n"
+    "    { name = 'occluder', shape = 'plane', size = {0.8, 0.8}, translate = {0.1, 2, -0.05}, receiver = false },\n"
+    "  },\n"
+    "}\n";
+
+#define SQ_OCC_Y 2.0
+#define SQ_OCC_X 0.1
+#define SQ_OCC_Z -0.05
+#define SQ_OCC_HALF 0.4
+
+/* Light sample k in world units: the rect's axes a = up x normal w / 2 =
+ * (0.5, 0, 0) and b = up h / 2 = (0, 0, 0.5) (softmap.c's light_axes). */
+static vec3 square_light_point(int tiles, int k)
+{
+    double a, b;
+    backproject_light_sample(tiles, k, true, &a, &b);
+    return v3((float)(0.5 * a), 4.0f, (float)(0.5 * b));
+}
+
+/* Where the segment p -> l crosses the occluder's plane, and its distance
+ * (world units) to the occluder's boundary, signed: > 0 inside. */
+static double occluder_margin(vec3 p, vec3 l)
+{
+    double t = (SQ_OCC_Y - p.y) / (l.y - p.y);
+    double x = p.x + t * (l.x - p.x) - SQ_OCC_X, z = p.z + t * (l.z - p.z) - SQ_OCC_Z;
+    return SQ_OCC_HALF - fmax(fabs(x), fabs(z));
+}
+
+/* Exact visible fraction of the square light: 1 - overlap of the occluder
+ * projected from p onto the light's plane (y = 4) with [-0.5, 0.5]^2. */
+static double square_exact(vec3 p)
+{
+    double k = (4.0 - p.y) / (SQ_OCC_Y - p.y);
+    double x0 = p.x + (SQ_OCC_X - SQ_OCC_HALF - p.x) * k, x1 = p.x + (SQ_OCC_X + SQ_OCC_HALF - p.x) * k;
+    double z0 = p.z + (SQ_OCC_Z - SQ_OCC_HALF - p.z) * k, z1 = p.z + (SQ_OCC_Z + SQ_OCC_HALF - p.z) * k;
+    double wx = fmax(0.0, fmin(x1, 0.5) - fmax(x0, -0.5)), wz = fmax(0.0, fmin(z1, 0.5) - fmax(z0, -0.5));
+    return 1.0 - wx * wz;
+}
+
+static bool occluded(RTCScene rs, vec3 p, vec3 l, float lift, vec3 n)
+{
+    struct RTCRayHit rh; /* rtcOccluded1 reads the ray part */
+    struct RTCRay *ray = &rh.ray;
+    vec3 o = v3(p.x + lift * n.x, p.y + lift * n.y, p.z + lift * n.z);
+    ray->org_x = o.x, ray->org_y = o.y, ray->org_z = o.z;
+    ray->dir_x = l.x - o.x, ray->dir_y = l.y - o.y, ray->dir_z = l.z - o.z;
+    ray->tnear = 0.0f, ray->tfar = 1.0f, ray->time = 0.0f, ray->mask = 0xffffffffu, ray->flags = 0, ray->id = 0;
+    struct RTCIntersectContext ic;
+    rtcInitIntersectContext(&ic);
+    rtcOccluded1(rs, &ic, ray);
+    return ray->tfar < 0.0f;
+}
+
+/* Bitmask against (a) Embree traced toward the very same 256 light samples
+ * and (b) the closed form. A receiver's bitmask may differ from (a) only by
+ * samples whose ray crosses the occluder's plane within one lexel (2^level
+ * texels, diagonal) of its boundary: the map places the occluder's edges to
+ * a texel (rasterised coverage, micropatch edges on texel edges, microquad
+ * vertices on covered texels' centres). Against (b) add the sample count's
+ * own quantisation, measured. */
+TEST(test_backprojection_bitmask_exact_for_a_parallel_square)
+{
+    Lab *lab = fixture_lab("square.lua", square_scene);
+    CHECK(lab);
+    Error err;
+    const int tiles = 8, N = 4 * tiles * tiles;
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    const RtScene *bvh = res_bvh(lab_resources(lab), lab_scene(lab), RT_CASTERS, &err);
+    CHECK(vs && cls && bvh);
+    double dx = soft_map_dx(lab, "backprojection", 256);
+    float extent = scene_extent(lab_scene(lab));
+    static const char *const reps[] = {"occluder=micropatch", "occluder=microquad", "occluder=microtri"};
+    for (int rep = 0; rep < 3; rep++) {
+        const char *p[] = {"map_size=256", "budget=64", reps[rep], NULL};
+        RenderResult r;
+        CHECK(soft_render(lab, "backprojection", p, &r));
+        int ground = 0, penumbra = 0, outside_band = 0;
+        double worst_rt = 0, worst_exact = 0, worst_count = 0, mean_rt = 0;
+        for (int s = 0; s < vs->count; s++) {
+            if (cls[s] != SAMPLE_LIT_CANDIDATE || vs->object[s] != 0) continue;
+            vec3 pw = vs->p_world[s], n = vs->n_geom_world[s];
+            double delta = (1 << (int)r.aux.data[s]) * dx * SQ_OCC_Y * sqrt(2.0); /* depth 2 from the light */
+            int hits = 0, band = 0;
+            for (int k = 0; k < N; k++) {
+                vec3 l = square_light_point(tiles, k);
+                hits += occluded(rt_scene_handle(bvh), pw, l, rt_ray_offset(extent, pw), n);
+                band += fabs(occluder_margin(pw, l)) <= delta;
+            }
+            double v = r.visibility.data[s], v_rt = 1.0 - (double)hits / N, exact = square_exact(pw);
+            double e = fabs(v - v_rt);
+            CHECK_MSG(e <= (double)band / N + 1e-9,
+                      "%s, sample %d: |bitmask %.4f - same-sample Embree %.4f| beyond the %d samples within a lexel "
+                      "of the edges", reps[rep], s, v, v_rt, band);
+            ground++;
+            penumbra += exact > 0.01 && exact < 0.99;
+            outside_band += band == 0;
+            worst_rt = fmax(worst_rt, e);
+            mean_rt += e;
+            if (band == 0) CHECK(e == 0.0);
+            worst_count = fmax(worst_count, fabs(v_rt - exact));
+            worst_exact = fmax(worst_exact, fabs(v - exact));
+        }
+        mean_rt /= ground;
+        printf("    %s: %d ground samples (%d penumbra, %d with no sample near an edge: equal); |bitmask - "
+               "same-sample Embree| max %.4f mean %.5f; |same-sample - closed form| max %.4f; |bitmask - closed "
+               "form| max %.4f\n",
+               reps[rep], ground, penumbra, outside_band, worst_rt, mean_rt, worst_count, worst_exact);
+        CHECK(penumbra > 500 && outside_band > ground / 2);
+        /* The RGSS tiling's 4 tiles distinct abscissae (and ordinates) hold
+         * tiles samples each: an axis-aligned edge miscounts at most half a
+         * column of the light, 1 / (8 tiles) per edge, four edges. */
+        CHECK_MSG(worst_count <= 4.0 / (8.0 * tiles), "sample count error %.4f above 4 / (8 tiles)", worst_count);
+        render_result_free(&r);
+    }
+    lab_close(lab);
+}
+
+/* Sum of the shadow 1 - v over the ground's lit candidates. */
+static double shadow_sum(Lab *lab, const Image *v)
+{
+    Error err;
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    double sum = 0;
+    for (int s = 0; vs && cls && s < vs->count; s++)
+        if (cls[s] == SAMPLE_LIT_CANDIDATE && vs->object[s] == 0) sum += 1.0 - v->data[(size_t)s * v->channels];
+    return sum;
+}
+
+static double reference_shadow_sum(Lab *lab, int samples)
+{
+    Error err;
+    RefInfo info;
+    RefRequest rq = {0, {MEASURE_VISIBILITY, samples, SAMPLING_STRATIFIED, 1}, NULL};
+    const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
+    return ref ? shadow_sum(lab, &ref->value) : NAN;
+}
+
+/* Course §5.2.3.3 on sphere-on-plane (160 x 120, 64-sample reference):
+ * micropatches over-occlude (penumbra too dark), without gap filling they
+ * leak in the umbra, summed areas over-occlude further where the
+ * gap-filled patches overlap; microquads under-occlude (penumbra too light). */
+TEST(test_backprojection_occluder_biases_on_sphere_on_plane)
+{
+    Lab *lab = soft_open("sphere-on-plane.lua", NULL);
+    CHECK(lab);
+    static const char *const runs[][3] = {
+        {"occluder=micropatch", "gaps=diagonal", NULL}, {"occluder=micropatch", "gaps=none", NULL},
+        {"occluder=micropatch", "accumulate=area", NULL}, {"occluder=microquad", NULL, NULL},
+        {"occluder=microtri", NULL, NULL},
+    };
+    Metrics m[5];
+    for (int k = 0; k < 5; k++) {
+        RenderResult r;
+        CHECK(soft_render(lab, "backprojection", runs[k], &r));
+        CHECK(soft_metrics(lab, &r.visibility, 64, &m[k]));
+        printf("    %-20s %-16s penumbra signed %+.4f RMSE %.4f; umbra leak %.4f\n", runs[k][0],
+               runs[k][1] ? runs[k][1] : "", m[k].region[REGION_PENUMBRA].mean_signed,
+               m[k].region[REGION_PENUMBRA].rmse, m[k].region[REGION_UMBRA].leak_mean);
+        render_result_free(&r);
+    }
+    CHECK_MSG(m[0].region[REGION_PENUMBRA].mean_signed < 0, "micropatches no longer over-occlude");
+    CHECK_MSG(m[1].region[REGION_UMBRA].leak_mean > 10 * m[0].region[REGION_UMBRA].leak_mean &&
+                  m[1].region[REGION_UMBRA].leak_mean > 0.01,
+              "without gap filling the umbra no longer leaks (%.4f against %.4f)", m[1].region[REGION_UMBRA].leak_mean,
+              m[0].region[REGION_UMBRA].leak_mean);
+    CHECK_MSG(m[2].region[REGION_PENUMBRA].mean_signed < m[0].region[REGION_PENUMBRA].mean_signed - 0.02,
+              "summed areas no longer over-occlude where patches overlap");
+    CHECK_MSG(m[3].region[REGION_PENUMBRA].mean_signed > 0, "microquads no longer under-occlude");
+    CHECK(m[4].region[REGION_PENUMBRA].mean_signed < m[3].region[REGION_PENUMBRA].mean_signed);
+    for (int k = 0; k < 5; k++) CHECK(m[k].region[REGION_UMBRA].leak_mean < 0.05 || k == 1);
+    lab_close(lab);
+}
+
+/* A twig: a bar 0.8 texels wide (map_size 256) at height 2 under a small
+ * sphere light at 4. The rasteriser covers at most one texel per map row,
+ * (the twig is centred on a texel column), so no 2 x 2 block of texels passes: microquads (and microtris, which need
+ * three of four) lose the whole shadow; micropatches keep it, a whole
+ * texel wide: 1 / 0.8 = 1.25 x the shadow (course §5.2.3.3). Shadow = sum of 1 - v over the ground. */
+TEST(test_backprojection_microquads_lose_one_texel_twigs)
+{
+    Lab *probe = soft_strip("{ type = 'sphere', position = {0, 4, 0}, radius = 0.15 }", 2.0);
+    CHECK(probe);
+    double dx = soft_map_dx(probe, "backprojection", 256);
+    lab_close(probe);
+    double width = 0.8 * dx * 2.0; /* 0.8 texels at depth 2 */
+    double shift = 0.5 * dx * 2.0;  /* the map's axis runs along a texel edge: centre the twig on a column */
+    char text[1024];
+    snprintf(text, sizeof text,
+             "return {\n"
+             "  camera = { position = {0, 6, 3}, target = {0, 0, 0}, fov = 50, width = 128, height = 96 },\n"
+             "  lights = { { type = 'sphere', position = {0, 4, 0}, radius = 0.15 } },\n"
+             "  objects = {\n"
+             "    { name = 'ground', shape = 'plane', size = {8, 8} },\n"
+             "    { name = 'twig', shape = 'plane', size = {%.9g, 8}, translate = {%.9g, 2, 0}, receiver = false },\n"
+             "  },\n"
+             "}\n",
+             width, shift);
+    Lab *lab = fixture_lab("twig.lua", text);
+    CHECK(lab);
+    CHECK_NEAR(soft_map_dx(lab, "backprojection", 256), dx, 1e-6 * dx); /* the same map fit */
+    double ref = reference_shadow_sum(lab, 256);
+    static const char *const reps[] = {"occluder=micropatch", "occluder=microquad", "occluder=microtri"};
+    double ratio[3];
+    for (int k = 0; k < 3; k++) {
+        const char *p[] = {"map_size=256", reps[k], NULL};
+        RenderResult r;
+        CHECK(soft_render(lab, "backprojection", p, &r));
+        ratio[k] = shadow_sum(lab, &r.visibility) / ref;
+        printf("    twig %.4f wide (0.8 texels): %s shadow %.3f x the reference's\n", width, reps[k], ratio[k]);
+        render_result_free(&r);
+    }
+    CHECK(ref > 20);
+    CHECK_MSG(fabs(ratio[0] - 1.25) < 0.1, "micropatches' twig shadow %.3f x, not a texel's 1.25 x", ratio[0]);
+    CHECK_MSG(ratio[1] < 0.05 && ratio[2] < 0.05, "microquads kept a one-texel twig (%.3f, %.3f)", ratio[1], ratio[2]);
+    lab_close(lab);
+}
+
+/* Receivers at the light's own depth (a wall through the light's plane):
+ * z_q -> p_z stays finite and in [0, 1] for every representation. */
+TEST(test_backprojection_receivers_at_the_lights_depth_stay_finite)
+{
+    static const char *const scene =
+        "return {\n"
+        "  camera = { position = {3, 3, 5}, target = {0, 1.5, 0}, fov = 60, width = 64, height = 48 },\n"
+        "  lights = { { type = 'sphere', position = {0, 2, 0}, radius = 0.3 } },\n"
+        "  objects = {\n"
+        "    { name = 'ground', shape = 'plane', size = {6, 6} },\n"
+        "    { name = 'wall', shape = 'box', size = {0.2, 4, 3}, translate = {1, 2, 0} },\n"
+        "    { name = 'block', shape = 'box', size = {0.5, 0.5, 0.5}, translate = {0, 0.8, 0.6} },\n"
+        "  },\n"
+        "}\n";
+    Lab *lab = fixture_lab("wall.lua", scene);
+    CHECK(lab);
+    static const char *const reps[] = {"occluder=micropatch", "occluder=microquad", "occluder=microtri"};
+    for (int k = 0; k < 3; k++) {
+        const char *p[] = {"map_size=128", reps[k], NULL};
+        RenderResult r;
+        CHECK(soft_render(lab, "backprojection", p, &r));
+        long bad = 0, n = (long)r.visibility.width * r.visibility.height;
+        for (long s = 0; s < n; s++) bad += !(r.visibility.data[s] >= 0.0f && r.visibility.data[s] <= 1.0f);
+        CHECK_MSG(bad == 0, "%s: %ld samples non-finite or outside [0, 1]", reps[k], bad);
+        render_result_free(&r);
+    }
+    lab_close(lab);
+}
+
+/* light_sampling (course §5.2.4) on the parallel square: the penumbra RMSE
+ * against the closed form (no reference noise) for N = 1, 4, 16, 64 maps
+ * (512^2, the R2 pattern) falls as 1/sqrt(N) or faster: its log-log slope
+ * is at most -1/2 and each sixteenfold N at least quarters it (fourfold
+ * steps alone are not monotone in rate: R2's first 16 points are no better
+ * spread in x than its first 4 by a factor 2). A random pattern converges
+ * too (each sixteenfold N at least halves it, one realisation). */
+static double ls_penumbra_rmse(Lab *lab, const char *samples, const char *pattern)
+{
+    Error err;
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    const char *p[] = {"map_size=512", samples, pattern, NULL};
+    RenderResult r;
+    if (!vs || !cls || !soft_render(lab, "light_sampling", p, &r)) return NAN;
+    double sum = 0;
+    long n = 0;
+    for (int s = 0; s < vs->count; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE || vs->object[s] != 0) continue;
+        double exact = square_exact(vs->p_world[s]), e = r.visibility.data[s] - exact;
+        if (!(exact > 0.01 && exact < 0.99)) continue;
+        sum += e * e;
+        n++;
+    }
+    render_result_free(&r);
+    return n > 500 ? sqrt(sum / n) : NAN;
+}
+
+TEST(test_light_sampling_converges_as_one_over_sqrt_n)
+{
+    Lab *lab = fixture_lab("square.lua", square_scene);
+    CHECK(lab);
+    static const char *const counts[] = {"samples=1", "samples=4", "samples=16", "samples=64"};
+    double r2[4], rnd[4];
+    for (int k = 0; k < 4; k++) {
+        r2[k] = ls_penumbra_rmse(lab, counts[k], "pattern=r2");
+        rnd[k] = ls_penumbra_rmse(lab, counts[k], "pattern=random");
+        printf("    %-10s penumbra RMSE r2 %.4f, random %.4f\n", counts[k], r2[k], rnd[k]);
+        CHECK(isfinite(r2[k]) && isfinite(rnd[k]));
+    }
+    /* least-squares slope of log RMSE against log N */
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int k = 0; k < 4; k++) {
+        double x = log(pow(4.0, k)), y = log(r2[k]);
+        sx += x, sy += y, sxx += x * x, sxy += x * y;
+    }
+    double slope = (4 * sxy - sx * sy) / (4 * sxx - sx * sx);
+    printf("    r2: RMSE ~ N^%.2f\n", slope);
+    CHECK_MSG(slope <= -0.5, "r2: RMSE falls as N^%.2f, slower than 1/sqrt(N)", slope);
+    for (int k = 2; k < 4; k++) {
+        CHECK_MSG(r2[k] <= 0.25 * r2[k - 2], "r2: %s RMSE %.4f above a quarter of N/16's %.4f", counts[k], r2[k],
+                  r2[k - 2]);
+        CHECK_MSG(rnd[k] <= 0.5 * rnd[k - 2], "random: %s RMSE %.4f above half of N/16's %.4f", counts[k], rnd[k],
+                  rnd[k - 2]);
+    }
+    lab_close(lab);
+}
+
+/* occlusion_textures (course §5.2.5) where its assumptions hold: one planar
+ * occluder parallel to a square light (the strip at height 1 under a 1 x 1
+ * rect at 4, the ground a slice of its own): the box filter of the strip's
+ * slice is the exact visible fraction, up to the map's sampling of the
+ * strip's edges and the window's rounding to whole texels (half a texel of
+ * each, in a penumbra W texels wide: rms (1/sqrt(12) + 1/2) / W). Where the
+ * fusion is multiplicative (overlap.lua: the high slab over the low slab's
+ * edge; and the ball of sphere-on-plane, whose first layer spreads over
+ * every slice as rings), the umbra leaks: measured, a documented failure. */
+TEST(test_occlusion_textures_exact_for_parallel_planes_and_leaky_fusion)
+{
+    Lab *lab = soft_strip("{ type = 'rect', position = {0, 4, 0}, direction = {0, -1, 0}, up = {0, 0, 1}, "
+                          "width = 1, height = 1 }",
+                          1.0);
+    CHECK(lab);
+    const char *p[] = {"map_size=512", NULL};
+    RenderResult r;
+    Metrics m;
+    CHECK(soft_render(lab, "occlusion_textures", p, &r));
+    CHECK(soft_metrics(lab, &r.visibility, 1024, &m));
+    double dx = soft_map_dx(lab, "occlusion_textures", 512);
+    double W = 1.0 * (4.0 - 3.0) / (4.0 * 3.0) / dx; /* light width (r_z - c_z) / (r_z c_z), texels */
+    double bound = (1 / sqrt(12.0) + 0.5) / W;
+    const ErrorStats *pe = &m.region[REGION_PENUMBRA];
+    printf("    strip: penumbra %ld samples, RMSE %.4f (bound %.4f + noise %.4f), umbra MAE %.4f, lit MAE %.4f\n",
+           pe->count, pe->rmse, bound, pe->noise_rms, m.region[REGION_UMBRA].mae, m.region[REGION_LIT].mae);
+    CHECK(pe->count > 300);
+    CHECK_MSG(pe->rmse <= bound + pe->noise_rms, "penumbra RMSE %.4f above %.4f", pe->rmse, bound + pe->noise_rms);
+    CHECK(m.region[REGION_UMBRA].mae < 0.01 && m.region[REGION_LIT].mae < 0.01);
+    render_result_free(&r);
+    lab_close(lab);
+
+    static const char *const scenes[] = {"overlap.lua", "sphere-on-plane.lua"};
+    for (int k = 0; k < 2; k++) {
+        Lab *l2 = soft_open(scenes[k], NULL);
+        CHECK(l2);
+        const char *none[] = {NULL};
+        CHECK(soft_render(l2, "occlusion_textures", none, &r));
+        CHECK(soft_metrics(l2, &r.visibility, 64, &m));
+        printf("    %s (8 slices): umbra %ld samples, leak %.4f; penumbra RMSE %.4f\n", scenes[k],
+               m.region[REGION_UMBRA].count, m.region[REGION_UMBRA].leak_mean, m.region[REGION_PENUMBRA].rmse);
+        CHECK_MSG(m.region[REGION_UMBRA].leak_mean > 0.05, "%s: the multiplicative fusion no longer leaks", scenes[k]);
+        render_result_free(&r);
+        lab_close(l2);
+    }
+}
+
+/* Bad input of issue 15: one slice, and 16 slices on a scene of one plane
+ * (a caster depth range of zero): finite, in [0, 1], and the lone plane
+ * does not shadow itself. */
+TEST(test_occlusion_textures_one_slice_and_one_plane_stay_finite)
+{
+    static const char *const plane_scene =
+        "return {\n"
+        "  camera = { position = {0, 5, 3}, target = {0, 0, 0}, fov = 50, width = 64, height = 48 },\n"
+        "  lights = { { type = 'sphere', position = {0, 4, 0}, radius = 0.5 } },\n"
+        "  objects = { { name = 'ground', shape = 'plane', size = {6, 6} } },\n"
+        "}\n";
+    Lab *planes[2] = {soft_open("sphere-on-plane.lua", NULL), fixture_lab("plane.lua", plane_scene)};
+    static const char *const slices[] = {"slices=1", "slices=16"};
+    for (int k = 0; k < 2; k++) {
+        CHECK(planes[k]);
+        const char *p[] = {slices[k], NULL};
+        RenderResult r;
+        CHECK(soft_render(planes[k], "occlusion_textures", p, &r));
+        Error err;
+        const uint8_t *cls = res_classes(lab_resources(planes[k]), lab_scene(planes[k]), 0, &err);
+        CHECK(cls);
+        long bad = 0, dark = 0, n = 0;
+        for (long s = 0; s < (long)r.visibility.width * r.visibility.height; s++) {
+            if (cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+            float v = r.visibility.data[s];
+            n++;
+            bad += !(v >= 0.0f && v <= 1.0f);
+            dark += v < 1.0f;
+        }
+        printf("    %s: %ld of %ld lit candidates outside [0, 1], %ld below 1\n", slices[k], bad, n, dark);
+        CHECK(bad == 0);
+        if (k == 1) CHECK_MSG(dark == 0, "the lone plane shadows itself in %ld samples", dark);
+        render_result_free(&r);
+        lab_close(planes[k]);
+    }
+}
