@@ -49,15 +49,15 @@ local result = exp:run(arg)
 local title = "Seed 002: single-sample soft shadows as the light grows"
 if result.sharded then return report.write(result, { title = title }) end
 
--- rho = sum |e| / sum (1 - V_ref) over the lit candidates (the reference's
--- standard error is 0 exactly outside them), from a comparison's images.
+-- rho = sum |e| / sum (1 - V_ref) over the lit candidates (class 1), from a
+-- comparison's images.
 local function relative_error(run)
-  local err, ref, se = run:image("error"), run:image("reference"), run:image("stderr")
+  local err, ref, cls = run:image("error"), run:image("reference"), run:image("class")
   local w, h = err:size()
   local e_sum, dark_sum = 0, 0
   for y = 1, h do
     for x = 1, w do
-      if se:get(x, y) > 0 then
+      if cls:get(x, y) == 1 then
         e_sum = e_sum + math.abs(err:get(x, y))
         dark_sum = dark_sum + (1 - ref:get(x, y))
       end

@@ -85,15 +85,15 @@ function figures.leaks(r)
 end
 
 -- Umbra (V <= 0.01) and penumbra (0.01 < V < 0.99) fractions of the light-
--- facing samples (the reference's standard error is > 0 exactly there) in
--- a run's visibility and in its reference.
+-- facing samples (the lit candidates, class 1) in a run's visibility and in
+-- its reference.
 function figures.areas(run)
-  local vis, ref, se = run:image("visibility"), run:image("reference"), run:image("stderr")
+  local vis, ref, cls = run:image("visibility"), run:image("reference"), run:image("class")
   local w, h = vis:size()
   local n, a = 0, { umbra = 0, penumbra = 0, ref_umbra = 0, ref_penumbra = 0 }
   for y = 1, h do
     for x = 1, w do
-      if se:get(x, y) > 0 then
+      if cls:get(x, y) == 1 then
         n = n + 1
         local v, r = vis:get(x, y), ref:get(x, y)
         if v <= 0.01 then a.umbra = a.umbra + 1 elseif v < 0.99 then a.penumbra = a.penumbra + 1 end

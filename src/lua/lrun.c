@@ -6,10 +6,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include "lua/sl_lua.h"
+#include "resources/standard.h"
 
 typedef struct LuaRun {
     CompareResult res;        /* render and signed error owned; res.ref not used */
     Image ref_value, ref_stderr;
+    Image sample_class;       /* SampleClass per view sample (scene/light.h), as floats */
 } LuaRun;
 
 static LuaRun *check_run(lua_State *L) { return luaL_checkudata(L, 1, SL_RUN_TYPE); }
@@ -18,6 +20,19 @@ static bool copy_image(const Image *src, Image *dst, Error *err)
 {
     if (!image_init(dst, src->width, src->height, src->channels, err)) return false;
     memcpy(dst->data, src->data, image_count(src) * sizeof(float));
+    return true;
+}
+
+/* The view samples' classes for the run's light as a one-channel image, so
+ * scripts select lit candidates by class (their reference's standard error
+ * is 0 wherever every batch agrees, lit or umbra alike). */
+static bool copy_classes(const RunReport *rep, Image *dst, Error *err)
+{
+    ResourceManager *rm = lab_resources(rep->lab);
+    const ViewSamples *vs = res_view_samples(rm, lab_scene(rep->lab), err);
+    const uint8_t *cls = vs ? res_classes(rm, lab_scene(rep->lab), rep->light_index, err) : NULL;
+    if (!cls || !image_init(dst, vs->width, vs->height, 1, err)) return false;
+    for (int s = 0; s < vs->count; s++) dst->data[s] = cls[s];
     return true;
 }
 
@@ -56,10 +71,11 @@ void sl_push_run(lua_State *L, CompareResult *res, const RunReport *rep)
     if (res->ref && (!copy_image(&res->ref->value, &run->ref_value, &err) ||
                      !copy_image(&res->ref->std_error, &run->ref_stderr, &err)))
         sl_raise(L, &err);
+    if (!copy_classes(rep, &run->sample_class, &err)) sl_raise(L, &err);
     /* Tell the collector about the images it cannot see, so a long sweep
      * collects finished Runs before their pixels pile up. */
     size_t pixels = image_count(&run->res.render.visibility) + image_count(&run->res.signed_error) +
-                    image_count(&run->ref_value) + image_count(&run->ref_stderr);
+                    image_count(&run->ref_value) + image_count(&run->ref_stderr) + image_count(&run->sample_class);
     lua_gc(L, LUA_GCSTEP, (int)(pixels * sizeof(float) / 1024));
     size_t len;
     char *json = record_text(L, rep, &len);
@@ -85,12 +101,14 @@ static int run_metrics(lua_State *L)
     return 1;
 }
 
-/* run:image(name): a copy of "visibility", "reference", "stderr" or "error". */
+/* run:image(name): a copy of "visibility", "reference", "stderr", "error" or
+ * "class" (SampleClass per sample: 1 is a lit candidate, the samples scored). */
 static int run_image(lua_State *L)
 {
     LuaRun *run = check_run(L);
-    static const char *const names[] = {"visibility", "reference", "stderr", "error", NULL};
-    const Image *images[] = {&run->res.render.visibility, &run->ref_value, &run->ref_stderr, &run->res.signed_error};
+    static const char *const names[] = {"visibility", "reference", "stderr", "error", "class", NULL};
+    const Image *images[] = {&run->res.render.visibility, &run->ref_value, &run->ref_stderr, &run->res.signed_error,
+                             &run->sample_class};
     int which = luaL_checkoption(L, 2, NULL, names);
     if (!images[which]->data) return luaL_error(L, "run:image: this run has no %s image", names[which]);
     sl_push_image_copy(L, images[which]);
@@ -103,6 +121,7 @@ static int run_gc(lua_State *L)
     compare_result_free(&run->res);
     image_free(&run->ref_value);
     image_free(&run->ref_stderr);
+    image_free(&run->sample_class);
     return 0;
 }
 

@@ -249,7 +249,7 @@ run_repro seed000-fig3 $TINYQ
 run_repro seed001-adaptive-area $TINYQ
 run_repro seed002-single-sample $TINYQ
 run_repro seed003-table1 --reps 1 --view 16 --sizes 256,512 --scenes scenes/sphere-on-plane.lua
-run_repro course-fig4.3-pcf-umbra --set camera.width=80 --set camera.height=60 --samples 32 --repeats 1 --warmup 0 \
+run_repro course-fig4.3-pcf-umbra --set camera.width=80 --set camera.height=60 --samples 32 --repeat 1 --warmup 0 \
     --no-images --quiet --threads 1 # 32x24 and 4 samples leave no penumbra to compare
 run_repro course-fig4.7-csm-terms --map-size 128 $TINYQ
 run_repro fig3-10-12-partitions $TINYQ
