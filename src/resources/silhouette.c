@@ -63,7 +63,7 @@ typedef struct EdgeSlot {
     uint32_t lo, hi;
     int32_t triangles;
     int32_t dir_sum;      /* sum of +1 (lo -> hi) / -1: 0 on a consistently oriented shared edge */
-    int32_t front_sum;    /* the same over triangles whose front faces the centre */
+    int32_t back_sum;     /* minus the same, over triangles whose back faces the centre */
     int32_t signed_sum;   /* over every triangle, times its facing (+1, -1, 0) */
 } EdgeSlot;
 
@@ -121,7 +121,7 @@ static void count_edges(ObjectBuild *ob, const double L[4], SilObject *so)
             int dir = a < b ? 1 : -1;
             e->triangles++;
             e->dir_sum += dir;
-            e->front_sum += f > 0 ? dir : 0;
+            e->back_sum -= f < 0 ? dir : 0;
             e->signed_sum += f * dir;
         }
     }
@@ -143,12 +143,12 @@ static bool collect(ObjectBuild *ob, SilObject *so, Silhouette *sil, int *cap)
     so->closed = so->open_edges == 0 && so->nonmanifold_edges == 0 && so->misoriented_edges == 0;
     for (int k = 0; k < ob->mesh->num_triangles; k++) {
         int f = ob->facing[k];
-        so->weight[k] = (int8_t)(f == 2 ? 0 : so->closed ? f > 0 : f);
+        so->weight[k] = (int8_t)(f == 2 ? 0 : so->closed ? -(f < 0) : f);
     }
     const vec3 *pos = ob->mesh->positions;
     for (size_t i = 0; i < t->size; i++) {
         const EdgeSlot *e = &t->slot[i];
-        int m = so->closed ? e->front_sum : e->signed_sum;
+        int m = so->closed ? e->back_sum : e->signed_sum;
         if (!e->triangles || m == 0) continue;
         SilEdge *edges = array_room(sil->edges, sil->num_edges, cap, sizeof *edges, 256);
         if (!edges) return false;

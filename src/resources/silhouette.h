@@ -11,8 +11,10 @@
  * double) are skipped and counted.
  *
  * Silhouette (course §2.2): each triangle is given a weight w toward the
- * centre L: on a closed object w = 1 where the triangle's front faces L and 0
- * elsewhere (only light-silhouette edges are extruded); on any other object
+ * centre L: on a closed object w = -1 where the triangle's back faces L and 0
+ * elsewhere (only light-silhouette edges are extruded, and the volume starts
+ * at the dark side, which bounds the same shadow as the course's light-facing
+ * front cap, but no lit surface lies on a cap); on any other object
  * w = +1 where the front faces L and -1 where the back does (Bergeron 1986:
  * the triangle counts as turned toward the light, so a shared silhouette edge
  * gets 2 quads and an open edge 1), and 0 for a triangle edge-on to L

@@ -21,6 +21,7 @@ extern const Technique tech_pcss;
 extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
 extern const Technique tech_aliasing;
+extern const Technique tech_shadow_volume;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -39,6 +40,7 @@ static const Technique *const registry[] = {
     &tech_adaptive_area,
     &tech_shadow_width,
     &tech_aliasing,
+    &tech_shadow_volume,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }

@@ -1,0 +1,270 @@
+/* shadow_volume.c -- `shadow_volume`: Crow's shadow volumes counted per view
+ * sample (course §2.2). The volume of the casters for the light's centre is
+ * the possible silhouette edges' quads, extruded away from the centre
+ * (resources/silhouette.h: Bergeron's rule on meshes that are not closed, so
+ * open and non-manifold meshes are handled, not refused), and for z-fail the
+ * caps: the triangles turned toward the centre, and the same triangles
+ * extruded (far cap). The camera-space pass (raster/camera_count.h) counts
+ * the faces in front of each sample (z-pass, Heidmann 1991) or behind it
+ * (z-fail, Bilodeau & Songy 1999, "Carmack's reverse"); a count that is not
+ * zero means shadow (course §2.2 [OWN] correction: overlapping volumes give
+ * counts >= 2). Every light kind is shadowed from its centre, as `hard`. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "raster/camera_count.h"
+#include "resources/silhouette.h"
+#include "resources/standard.h"
+#include "techniques/technique.h"
+
+static const char *const method_names[] = {"zpass", "zfail", NULL};
+static const char *const extrusion_names[] = {"infinite", "finite", NULL};
+enum { SV_METHOD, SV_EXTRUSION, SV_DISTANCE, SV_OFFSET };
+enum { METHOD_ZPASS, METHOD_ZFAIL };
+enum { EXTRUDE_INFINITE, EXTRUDE_FINITE };
+
+static const ParamDesc sv_params[] = {
+    {"method", PARAM_ENUM, METHOD_ZFAIL, 0, 1, "",
+     "zpass: count volume faces in front of the sample (Heidmann 1991; wrong where the camera is inside a volume, "
+     "whose faces the near plane clips); zfail: count those behind it, volumes capped (Carmack's reverse)",
+     method_names},
+    {"extrusion", PARAM_ENUM, EXTRUDE_INFINITE, 0, 1, "",
+     "infinite: silhouette quads and far cap at infinity (homogeneous w = 0, Everitt & Kilgard 2002); finite: "
+     "extruded by `distance`, so receivers farther than that behind a caster are lit",
+     extrusion_names},
+    {"distance", PARAM_FLOAT, 1000.0, 1e-6, 1e9, "world units",
+     "extrusion=finite: how far each silhouette and cap vertex moves away from the light's centre", NULL},
+    {"offset_scale", PARAM_FLOAT, 1.0, 0.0, 1e4, "x rt_ray_offset",
+     "each sample is tested at its point lifted along the geometric normal by this multiple of the engine's "
+     "scale-aware ray offset (as `hard`'s ray origin), and nearer by the rasterizer's snapping margin, so the caps "
+     "through it do not count it",
+     NULL},
+};
+
+static const char *const sv_resources[] = {"silhouette", NULL};
+static const char *const sv_aux[] = {"count", NULL};
+
+/* The volume as one homogeneous mesh with a signed count per triangle. */
+typedef struct Volume {
+    vec3 *p;
+    float *w;
+    uint32_t *ix;
+    int16_t *count;
+    int nv, nt;
+} Volume;
+
+typedef struct Extrude {
+    double L[4];     /* the light's centre, homogeneous (silhouette.h) */
+    bool infinite;
+    float distance;  /* world units, finite extrusion */
+} Extrude;
+
+/* Vertex x moved away from the centre: the direction x L.w - L.xyz, at
+ * infinity (w = 0) or `distance` along it. */
+static void push_extruded(Volume *v, const Extrude *e, vec3 x)
+{
+    vec3 dir = v3((float)(x.x * e->L[3] - e->L[0]), (float)(x.y * e->L[3] - e->L[1]), (float)(x.z * e->L[3] - e->L[2]));
+    v->p[v->nv] = e->infinite ? dir : v3_madd(x, v3_normalize_or(dir, v3(0, 0, 0)), e->distance);
+    v->w[v->nv++] = e->infinite ? 0.0f : 1.0f;
+}
+
+static void push_point(Volume *v, vec3 x)
+{
+    v->p[v->nv] = x;
+    v->w[v->nv++] = 1.0f;
+}
+
+static void push_tri(Volume *v, uint32_t a, uint32_t b, uint32_t c, int16_t count)
+{
+    uint32_t *ix = &v->ix[3 * v->nt];
+    ix[0] = a;
+    ix[1] = b;
+    ix[2] = c;
+    v->count[v->nt++] = count;
+}
+
+/* Quad over the directed silhouette edge a -> b: (b, a, a', b'), which the
+ * triangles turned toward the centre traverse the other way round, so its
+ * front faces out of the volume. */
+static void push_quad(Volume *v, const Extrude *e, const SilEdge *s)
+{
+    uint32_t base = (uint32_t)v->nv;
+    push_point(v, s->b);
+    push_point(v, s->a);
+    push_extruded(v, e, s->a);
+    push_extruded(v, e, s->b);
+    push_tri(v, base, base + 1, base + 2, (int16_t)s->count);
+    push_tri(v, base, base + 2, base + 3, (int16_t)s->count);
+}
+
+/* Near cap (a, b, c) turned toward the centre, and the far cap (c', b', a'). */
+static void push_caps(Volume *v, const Extrude *e, vec3 a, vec3 b, vec3 c)
+{
+    uint32_t base = (uint32_t)v->nv;
+    push_point(v, a);
+    push_point(v, b);
+    push_point(v, c);
+    push_extruded(v, e, a);
+    push_extruded(v, e, b);
+    push_extruded(v, e, c);
+    push_tri(v, base, base + 1, base + 2, 1);
+    push_tri(v, base + 5, base + 4, base + 3, 1);
+}
+
+static void volume_free(Volume *v)
+{
+    free(v->p);
+    free(v->w);
+    free(v->ix);
+    free(v->count);
+}
+
+static bool volume_build(const Scene *scene, const Silhouette *sil, const Extrude *e, bool caps, Volume *v, Error *err)
+{
+    long quads = sil->num_edges, cap_tris = 0;
+    for (int i = 0; caps && i < sil->num_objects; i++)
+        for (int t = 0; t < sil->objects[i].triangles; t++) cap_tris += sil->objects[i].weight[t] != 0;
+    for (int i = 0; i < sil->num_edges; i++)
+        if (sil->edges[i].count > INT16_MAX)
+            return error_set(err, "shadow_volume: an edge of object '%s' is extruded %d times (at most %d)",
+                             scene->objects[sil->edges[i].object].name, sil->edges[i].count, INT16_MAX);
+    long nv = 4 * quads + 6 * cap_tris, nt = 2 * quads + 2 * cap_tris;
+    if (nv >= INT32_MAX || nt >= INT32_MAX / 3)
+        return error_set(err, "shadow_volume: %ld volume triangles exceed the rasterizer's range", nt);
+    memset(v, 0, sizeof *v);
+    v->p = malloc(sizeof *v->p * (size_t)(nv + 1));
+    v->w = malloc(sizeof *v->w * (size_t)(nv + 1));
+    v->ix = malloc(sizeof *v->ix * 3 * (size_t)(nt + 1));
+    v->count = malloc(sizeof *v->count * (size_t)(nt + 1));
+    if (!v->p || !v->w || !v->ix || !v->count) {
+        volume_free(v);
+        return error_set(err, "out of memory for %ld shadow-volume triangles", nt);
+    }
+    for (int i = 0; i < sil->num_edges; i++) push_quad(v, e, &sil->edges[i]);
+    for (int i = 0; caps && i < sil->num_objects; i++) {
+        const SilObject *so = &sil->objects[i];
+        const Mesh *m = &scene->objects[so->object].mesh;
+        for (int t = 0; t < so->triangles; t++) {
+            if (!so->weight[t]) continue;
+            const uint32_t *ix = &m->indices[3 * t];
+            vec3 a = m->positions[ix[0]], b = m->positions[ix[1]], c = m->positions[ix[2]];
+            if (so->weight[t] > 0) push_caps(v, e, a, b, c);
+            else push_caps(v, e, a, c, b);
+        }
+    }
+    return true;
+}
+
+typedef struct SvState {
+    int32_t *count; /* per view sample: the number of volumes it is in (z-fail's sign turned) */
+} SvState;
+
+/* The view depth each sample is tested at: its point lifted by the ray
+ * offset along the geometric normal (which faces the camera), d + off n.f,
+ * less the rasterizer's snapping margin: vertices snap to 1/256 of a sample
+ * (raster.h), which moves a plane's depth at a sample by up to its depth
+ * gradient times sqrt(2)/512 samples; the gradient of a surface at view
+ * distance d is d tan(gamma) 2 tan_y / H per sample (gamma between the
+ * normal and the view ray), and the margin is 1/256 of it (tan clamped at
+ * 1e3, grazing). Without it open meshes' caps, which lie on their surface,
+ * count their own samples. */
+static float *test_depths(const TechContext *ctx, double offset_scale)
+{
+    const ViewSamples *vs = ctx->vs;
+    const Camera *cam = &ctx->scene->camera;
+    vec3 f, r, u;
+    float tx, ty;
+    camera_axes(cam, vs->width, vs->height, &f, &r, &u, &tx, &ty);
+    float extent = scene_extent(ctx->scene), *d = malloc(sizeof *d * (size_t)vs->count);
+    float sample_angle = 2.0f * ty / (float)vs->height;
+    for (int s = 0; d && s < vs->count; s++) {
+        if (vs->object[s] < 0) { d[s] = 0.0f; continue; }
+        vec3 p = vs->p_world[s], n = vs->n_geom_world[s], ray = v3_normalize_or(v3_sub(p, cam->position), f);
+        float c = fabsf(v3_dot(n, ray)), tan_gamma = c > 1e-3f ? sqrtf(fmaxf(0.0f, 1.0f - c * c)) / c : 1e3f;
+        float off = (float)offset_scale * rt_ray_offset(extent, p);
+        float snap = vs->depth_view[s] * tan_gamma * sample_angle / 256.0f;
+        d[s] = vs->depth_view[s] + off * v3_dot(n, f) - snap;
+    }
+    return d;
+}
+
+static bool count_volumes(const TechContext *ctx, const Volume *v, int method, int32_t *out, Error *err)
+{
+    float *depth = test_depths(ctx, ctx->params[SV_OFFSET]);
+    if (!depth) return error_set(err, "out of memory for %d test depths", ctx->vs->count);
+    CameraCount cc;
+    bool ok = camera_count_init(&cc, &ctx->scene->camera, ctx->vs, depth, err);
+    free(depth);
+    if (!ok) return false;
+    RasterMesh mesh = {v->p, v->ix, v->nv, v->nt};
+    RasterMeshExtra extra = {v->w, v->count};
+    CountTest test = method == METHOD_ZPASS ? COUNT_NEARER : COUNT_FARTHER;
+    ok = camera_count_render(&cc, &mesh, &extra, 1, test, NULL, err);
+    /* z-pass counts entries minus exits in front of p; z-fail the exits
+     * minus entries behind it: the same number with the faces' signs turned */
+    for (int s = 0; ok && s < ctx->vs->count; s++) {
+        int32_t c = camera_count_at(&cc, s);
+        out[s] = method == METHOD_ZPASS ? c : c == INT32_MIN ? INT32_MAX : -c;
+    }
+    camera_count_free(&cc);
+    return ok;
+}
+
+static bool sv_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    const Silhouette *sil = res_silhouette(ctx->rm, ctx->scene, ctx->light_index, err);
+    if (!sil) return false;
+    int method = (int)ctx->params[SV_METHOD];
+    Extrude e = {{sil->light[0], sil->light[1], sil->light[2], sil->light[3]},
+                 (int)ctx->params[SV_EXTRUSION] == EXTRUDE_INFINITE, (float)ctx->params[SV_DISTANCE]};
+    Volume v;
+    if (!volume_build(ctx->scene, sil, &e, method == METHOD_ZFAIL, &v, err)) return false;
+    SvState *st = malloc(sizeof *st);
+    int32_t *count = malloc(sizeof *count * (size_t)ctx->vs->count);
+    bool ok = st && count && count_volumes(ctx, &v, method, count, err);
+    volume_free(&v);
+    if (!ok) {
+        if (!st || !count) error_set(err, "out of memory for %d shadow-volume counts", ctx->vs->count);
+        free(st);
+        free(count);
+        return false;
+    }
+    st->count = count;
+    *state = st;
+    return true;
+}
+
+static void sv_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
+{
+    const SvState *st = state;
+    for (int s = begin; s < end; s++) {
+        if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        tech_store(ctx, out, begin, s, st->count[s] != 0 ? 0.0f : 1.0f); /* count != 0: shadowed */
+        if (ctx->aux) ctx->aux[s] = (float)st->count[s];
+    }
+}
+
+static void sv_release(void *state)
+{
+    SvState *st = state;
+    if (st) free(st->count);
+    free(st);
+}
+
+const Technique tech_shadow_volume = {
+    .name = "shadow_volume",
+    .family = "geometry",
+    .source = "course §2.2 (Crow 1977; z-pass Heidmann 1991; z-fail Bilodeau & Songy 1999; open meshes Bergeron 1986)",
+    .summary = "shadow volumes from the light's centre: silhouette quads (and caps) counted per view sample in camera "
+               "space, shadowed where the count is not zero",
+    .params = sv_params,
+    .num_params = (int)(sizeof sv_params / sizeof sv_params[0]),
+    .resources = sv_resources,
+    .rgb = true,
+    .lights = LIGHTS_ALL,
+    .main_param = "method",
+    .prepare = sv_prepare,
+    .evaluate = sv_evaluate,
+    .release = sv_release,
+    .aux = sv_aux,
+};

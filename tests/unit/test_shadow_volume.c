@@ -1,0 +1,214 @@
+/* test_shadow_volume.c -- `shadow_volume` against `hard` (the Embree ray
+ * toward the light's centre) at 160x120: with z-fail every lit candidate
+ * agrees except samples within a stated tolerance of a shadow-volume side
+ * face, each counted and checked; with the camera inside the ball's shadow
+ * z-pass (whose near plane clips the volume) is measured to fail and z-fail
+ * stays right; the counting pass refuses a counter leaving int32. About 1 s. */
+#include <stdlib.h>
+#include <string.h>
+#include "fixtures.h"
+#include "raster/camera_count.h"
+#include "resources/silhouette.h"
+#include "test.h"
+
+/* Disagreeing samples may lie this many ray offsets (rt_ray_offset) from a
+ * volume face: the test point itself is lifted by one, and the rasterizer
+ * snaps to 1/256 of a sample while Embree tests the exact ray. */
+#define FACE_TOLERANCE_OFFSETS 4.0
+
+static Lab *open_small(const char *scene, const char *const *extra, int n_extra)
+{
+    const char *over[8] = {"camera.width=160", "camera.height=120"};
+    for (int i = 0; i < n_extra; i++) over[2 + i] = extra[i];
+    char path[256];
+    snprintf(path, sizeof path, "scenes/%s", scene);
+    Error err;
+    Lab *lab = lab_open(path, over, 2 + n_extra, &err);
+    if (!lab) printf("    %s\n", err.msg);
+    return lab;
+}
+
+static bool render(Lab *lab, const char *tech, const char *assign, RenderResult *out)
+{
+    Error err;
+    const Technique *t = tech_find(tech, &err);
+    double params[TECH_MAX_PARAMS];
+    if (!t) { printf("    %s\n", err.msg); return false; }
+    tech_params_default(t, params);
+    if (assign && !tech_param_parse(t, assign, params, &err)) { printf("    %s\n", err.msg); return false; }
+    RenderRequest rq = {.tech = t, .params = params, .light_index = 0, .repeat = 1};
+    if (!lab_render(lab, &rq, out, &err)) { printf("    %s: %s\n", tech, err.msg); return false; }
+    return true;
+}
+
+/* Distance (world units) from p to the side face over silhouette edge a -> b:
+ * the convex planar region bounded by the segment and the rays from a and b
+ * away from the homogeneous centre L. */
+static double dist_point_ray(dvec3 p, dvec3 o, dvec3 u, bool segment)
+{
+    double uu = d3_dot(u, u), t = uu > 0.0 ? d3_dot(d3_sub(p, o), u) / uu : 0.0;
+    t = t < 0.0 ? 0.0 : segment && t > 1.0 ? 1.0 : t;
+    return d3_len(d3_sub(p, d3_madd(o, u, t)));
+}
+
+static double side_of(dvec3 p, dvec3 q, dvec3 u, dvec3 nrm) { return d3_dot(d3_cross(d3_sub(p, q), u), nrm); }
+
+static double dist_to_face(dvec3 p, const SilEdge *e, const double L[4])
+{
+    dvec3 a = d3_from(e->a), b = d3_from(e->b);
+    dvec3 da = d3_normalize_or(d3(a.x * L[3] - L[0], a.y * L[3] - L[1], a.z * L[3] - L[2]), d3(0, 0, 0));
+    dvec3 db = d3_normalize_or(d3(b.x * L[3] - L[0], b.y * L[3] - L[1], b.z * L[3] - L[2]), d3(0, 0, 0));
+    dvec3 nrm = d3_normalize_or(d3_cross(d3_sub(b, a), d3_add(da, db)), d3(0, 0, 0));
+    double plane = d3_dot(d3_sub(p, a), nrm);
+    dvec3 q = d3_madd(p, nrm, -plane), inner = d3_add(d3_scale(d3_add(a, b), 0.5), d3_scale(d3_add(da, db), 0.5));
+    bool inside = side_of(q, a, d3_sub(b, a), nrm) * side_of(inner, a, d3_sub(b, a), nrm) >= 0.0 &&
+                  side_of(q, a, da, nrm) * side_of(inner, a, da, nrm) >= 0.0 &&
+                  side_of(q, b, db, nrm) * side_of(inner, b, db, nrm) >= 0.0;
+    if (inside) return fabs(plane);
+    double d = dist_point_ray(p, a, d3_sub(b, a), true), r = dist_point_ray(p, a, da, false);
+    d = r < d ? r : d;
+    r = dist_point_ray(p, b, db, false);
+    return r < d ? r : d;
+}
+
+typedef struct Agreement {
+    long candidates, disagree, within, shadowed;
+    double worst_offsets; /* the largest distance of a disagreeing sample to a face, in ray offsets */
+} Agreement;
+
+static Agreement agreement(Lab *lab, const Image *est, const Image *truth)
+{
+    Error err;
+    Agreement g = {0};
+    const Scene *sc = lab_scene(lab);
+    ResourceManager *rm = lab_resources(lab);
+    const uint8_t *cls = res_classes(rm, sc, 0, &err);
+    const ViewSamples *vs = res_view_samples(rm, sc, &err);
+    const Silhouette *sil = res_silhouette(rm, sc, 0, &err);
+    if (!cls || !vs || !sil) return g;
+    float extent = scene_extent(sc);
+    for (int s = 0; s < vs->count; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        g.candidates++;
+        float e = est->data[(size_t)s * est->channels], t = truth->data[(size_t)s * truth->channels];
+        g.shadowed += t < 0.5f;
+        if ((e < 0.5f) == (t < 0.5f)) continue;
+        g.disagree++;
+        double best = INFINITY, off = rt_ray_offset(extent, vs->p_world[s]);
+        for (int i = 0; i < sil->num_edges; i++) {
+            double d = dist_to_face(d3_from(vs->p_world[s]), &sil->edges[i], sil->light);
+            best = d < best ? d : best;
+        }
+        g.within += best <= FACE_TOLERANCE_OFFSETS * off;
+        g.worst_offsets = best / off > g.worst_offsets ? best / off : g.worst_offsets;
+    }
+    return g;
+}
+
+static void print_agreement(const char *what, const Agreement *g)
+{
+    printf("    %s: %ld lit candidates (%ld shadowed by hard), %ld disagree, %ld of them within %.0f ray offsets of a "
+           "volume face (farthest %.2f)\n",
+           what, g->candidates, g->shadowed, g->disagree, g->within, FACE_TOLERANCE_OFFSETS, g->worst_offsets);
+}
+
+/* z-fail equals hard on a scene, but for samples at a volume face. */
+static void zfail_equals_hard(const char *scene, const char *const *extra, int n_extra, const char *assign)
+{
+    Lab *lab = open_small(scene, extra, n_extra);
+    CHECK(lab);
+    RenderResult hard, sv;
+    CHECK(render(lab, "hard", NULL, &hard));
+    CHECK(render(lab, "shadow_volume", assign, &sv));
+    Agreement g = agreement(lab, &sv.visibility, &hard.visibility);
+    print_agreement(scene, &g);
+    CHECK(g.candidates > 1000 && g.shadowed > 100);
+    CHECK_MSG(g.within == g.disagree, "%ld disagreeing samples farther than %.0f offsets from a face", g.disagree - g.within,
+              FACE_TOLERANCE_OFFSETS);
+    CHECK(g.disagree * 100 < g.shadowed); /* a rim, not an area */
+    render_result_free(&hard);
+    render_result_free(&sv);
+    lab_close(lab);
+}
+
+TEST(test_shadow_volume_zfail_equals_hard_on_sphere_on_plane)
+{
+    zfail_equals_hard("sphere-on-plane.lua", NULL, 0, "method=zfail");
+}
+
+TEST(test_shadow_volume_zpass_equals_hard_with_the_camera_outside)
+{
+    zfail_equals_hard("sphere-on-plane.lua", NULL, 0, "method=zpass");
+}
+
+TEST(test_shadow_volume_zfail_equals_hard_at_contacts)
+{
+    zfail_equals_hard("contact.lua", NULL, 0, "method=zfail");
+}
+
+TEST(test_shadow_volume_finite_extrusion_beyond_the_scene_equals_hard)
+{
+    zfail_equals_hard("sphere-on-plane.lua", NULL, 0, "extrusion=finite");
+}
+
+/* The camera under the ball, on the axis from the light's centre through the
+ * ball's centre (light (1.5, 5, 1), ball (0, 1, 0) radius 0.6), 0.79 from the
+ * ball's centre: inside its shadow volume, looking at lit ground. */
+TEST(test_shadow_volume_camera_inside_a_volume_zpass_fails_zfail_holds)
+{
+    const char *inside[] = {"camera.position={-0.27,0.28,-0.18}", "camera.target={2,0,2}"};
+    Lab *lab = open_small("sphere-on-plane.lua", inside, 2);
+    CHECK(lab);
+    RenderResult hard, zpass, zfail;
+    CHECK(render(lab, "hard", NULL, &hard));
+    CHECK(render(lab, "shadow_volume", "method=zpass", &zpass));
+    CHECK(render(lab, "shadow_volume", "method=zfail", &zfail));
+    Agreement p = agreement(lab, &zpass.visibility, &hard.visibility);
+    Agreement f = agreement(lab, &zfail.visibility, &hard.visibility);
+    print_agreement("camera inside, zpass", &p);
+    print_agreement("camera inside, zfail", &f);
+    CHECK(p.candidates > 1000);
+    /* the near plane cuts the volume the camera is in: every count is one short */
+    CHECK_MSG(p.disagree * 2 > p.candidates, "z-pass disagrees on only %ld of %ld", p.disagree, p.candidates);
+    CHECK(f.within == f.disagree);
+    CHECK(f.disagree * 100 < f.candidates);
+    render_result_free(&hard);
+    render_result_free(&zpass);
+    render_result_free(&zfail);
+    lab_close(lab);
+}
+
+/* Two front-facing triangles over texels whose counter starts one below
+ * INT32_MAX: the second update is refused and the pass fails, saying so. */
+TEST(test_shadow_volume_counter_overflow_is_reported)
+{
+    Lab *lab = open_small("sphere-on-plane.lua", NULL, 0);
+    CHECK(lab);
+    Error err;
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    CHECK(vs);
+    float *depth = malloc(sizeof *depth * (size_t)vs->count);
+    CHECK(depth);
+    for (int s = 0; s < vs->count; s++) depth[s] = 0.0f; /* at infinity: every fragment is nearer */
+    CameraCount cc;
+    CHECK(camera_count_init(&cc, &lab_scene(lab)->camera, vs, depth, &err));
+    free(depth);
+    for (int s = 0; s < vs->count; s++) cc.count[s] = INT32_MAX - 1;
+    const Camera *cam = &lab_scene(lab)->camera;
+    vec3 f, r, u;
+    float tx, ty;
+    camera_axes(cam, vs->width, vs->height, &f, &r, &u, &tx, &ty);
+    vec3 c = v3_madd(cam->position, f, 2.0f); /* a triangle facing the camera 2 units ahead */
+    vec3 p[3] = {v3_add(c, v3_scale(r, -0.3f)), v3_add(c, v3_scale(r, 0.3f)), v3_add(c, v3_scale(u, 0.3f))};
+    uint32_t ix[6] = {0, 1, 2, 0, 1, 2};
+    RasterMesh m = {p, ix, 3, 2};
+    RasterStats st;
+    bool ok = camera_count_render(&cc, &m, NULL, 1, COUNT_NEARER, &st, &err);
+    long max = 0;
+    for (int s = 0; s < vs->count; s++) max += cc.count[s] == INT32_MAX;
+    printf("    %ld counters at INT32_MAX; %s\n", max, ok ? "no error" : err.msg);
+    CHECK(!ok && strstr(err.msg, "would leave int32") != NULL);
+    CHECK(max > 100);
+    camera_count_free(&cc);
+    lab_close(lab);
+}
