@@ -212,3 +212,19 @@ TEST(test_shadow_volume_counter_overflow_is_reported)
     camera_count_free(&cc);
     lab_close(lab);
 }
+
+TEST(test_shadow_volume_zfail_equals_hard_on_cones_and_hills)
+{
+    zfail_equals_hard("cones-and-hills.lua", NULL, 0, "method=zfail");
+}
+
+/* The bunny has 223 open edges (its base): Bergeron's rule, caps on its own
+ * surface. Needs SHADOWLAB_MODEL_PATH (make test-unit sets ../shared/models). */
+TEST(test_shadow_volume_zfail_equals_hard_on_the_bunny)
+{
+    if (!getenv("SHADOWLAB_MODEL_PATH")) {
+        printf("    skipped: SHADOWLAB_MODEL_PATH is not set\n");
+        return;
+    }
+    zfail_equals_hard("bunny.lua", NULL, 0, "method=zfail");
+}
