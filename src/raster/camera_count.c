@@ -66,3 +66,65 @@ bool camera_count_render(CameraCount *cc, const RasterMesh *meshes, const Raster
                          .extra = extra};
     return raster_depth(meshes, num_meshes, &cc->view, &opt, &cc->db, stats, err);
 }
+
+/* Clip from world for the near caps: the camera's rows 0, 1 and 3 after
+ * Blinn's shadow matrix S = (pi.L) I - L pi^T, which takes x along the line
+ * from L onto the near plane pi (pi.x = f.x - f.e - n); row 2 is
+ * C n (pi.x). Then w = n (pi.L - pi.x) for a point light, and 0 <= z <= w
+ * keeps the slab 0 <= pi.x <= pi.L / (1 + C): the parts between the centre
+ * and the near plane (with C = 1e-9, all but a 1e-9 sliver at the centre).
+ * The rows are negated when pi.L < 0, so the slab is [pi.L, 0] and w > 0. */
+#define NEAR_CAP_SLAB 1e-9
+static mat4 near_cap_clip_from_world(const CameraCount *cc, const Camera *cam, const double L[4], double *pi_L)
+{
+    vec3 f, r, u;
+    float tx, ty;
+    camera_axes(cam, cc->width, cc->height, &f, &r, &u, &tx, &ty);
+    double pi[4] = {f.x, f.y, f.z,
+                    -(f.x * (double)cam->position.x + f.y * (double)cam->position.y + f.z * (double)cam->position.z) -
+                        cam->near_dist};
+    *pi_L = pi[0] * L[0] + pi[1] * L[1] + pi[2] * L[2] + pi[3] * L[3];
+    mat4 S;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) S.m[i][j] = (i == j ? *pi_L : 0.0) - L[i] * pi[j];
+    mat4 M = m4_mul(&cc->view.clip_from_world, &S);
+    double sign = *pi_L < 0.0 ? -1.0 : 1.0;
+    for (int j = 0; j < 4; j++) M.m[2][j] = NEAR_CAP_SLAB * cam->near_dist * pi[j];
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) M.m[i][j] *= sign;
+    return M;
+}
+
+bool camera_count_near_caps(CameraCount *cc, const Camera *cam, const RasterMesh *caps, const RasterMeshExtra *extra,
+                            const double L[4], RasterStats *stats, Error *err)
+{
+    double pi_L;
+    RasterView view = cc->view;
+    view.clip_from_world = near_cap_clip_from_world(cc, cam, L, &pi_L);
+    if (stats) memset(stats, 0, sizeof *stats);
+    if (pi_L == 0.0) return true;
+    size_t n = (size_t)cc->width * (size_t)cc->height;
+    float *all = malloc(n * sizeof *all);
+    int32_t *count = calloc(n, sizeof *count);
+    if (!all || !count) {
+        free(all);
+        free(count);
+        return error_set(err, "out of memory for %dx%d near-cap counters", cc->width, cc->height);
+    }
+    for (size_t i = 0; i < n; i++) all[i] = -1.0f; /* below every z_ndc >= 0: each fragment counts */
+    RasterOptions opt = {.cull = RASTER_CULL_NONE, .test = RASTER_COUNT_GREATER, .depth = RASTER_DEPTH_NDC,
+                         .count_ref = all, .count = count, .extra = extra};
+    bool ok = raster_depth(caps, 1, &view, &opt, &cc->db, stats, err);
+    /* A cap turned toward L, projected from L, keeps its orientation seen
+     * from L's side of the plane: counter-clockwise from the camera when L
+     * is on the camera's side (pi.L < 0), clockwise otherwise. */
+    int32_t sign = pi_L < 0.0 ? 1 : -1;
+    for (size_t i = 0; ok && i < n; i++) {
+        int64_t c = (int64_t)cc->count[i] + (int64_t)sign * count[i];
+        if (c > INT32_MAX || c < INT32_MIN) ok = error_set(err, "ZP+: a near-plane count leaves int32");
+        else cc->count[i] = (int32_t)c;
+    }
+    free(all);
+    free(count);
+    return ok;
+}

@@ -38,6 +38,16 @@ void camera_count_free(CameraCount *cc);
 bool camera_count_render(CameraCount *cc, const RasterMesh *meshes, const RasterMeshExtra *extra, int num_meshes,
                          CountTest test, RasterStats *stats, Error *err);
 
+/* ZP+ (Hornus et al. 2005; course §2.2): add to every counter the number of
+ * volumes holding the sample's point on the near plane, so that z-pass is
+ * right with the camera inside volumes. `caps` are the volumes' near caps
+ * (triangles turned toward the homogeneous centre L, each with its count);
+ * their parts between L and the near plane are projected from L onto the
+ * near plane and drawn from the camera, each adding its count whatever its
+ * orientation there. A centre on the near plane's plane adds nothing. */
+bool camera_count_near_caps(CameraCount *cc, const Camera *cam, const RasterMesh *caps, const RasterMeshExtra *extra,
+                            const double L[4], RasterStats *stats, Error *err);
+
 /* The counter of view sample s (sample order: row 0 at the top). */
 static inline int32_t camera_count_at(const CameraCount *cc, int s)
 {

@@ -6,7 +6,9 @@
  * caps: the triangles turned toward the centre, and the same triangles
  * extruded (far cap). The camera-space pass (raster/camera_count.h) counts
  * the faces in front of each sample (z-pass, Heidmann 1991) or behind it
- * (z-fail, Bilodeau & Songy 1999, "Carmack's reverse"); a count that is not
+ * (z-fail, Bilodeau & Songy 1999, "Carmack's reverse"), or in front of it
+ * from counts started at the near plane's (ZP+, Hornus et al. 2005: the near
+ * caps projected from the centre onto the near plane); a count that is not
  * zero means shadow (course §2.2 [OWN] correction: overlapping volumes give
  * counts >= 2). Every light kind is shadowed from its centre, as `hard`. */
 #include <math.h>
@@ -17,16 +19,18 @@
 #include "resources/standard.h"
 #include "techniques/technique.h"
 
-static const char *const method_names[] = {"zpass", "zfail", NULL};
+static const char *const method_names[] = {"zpass", "zfail", "zpplus", NULL};
 static const char *const extrusion_names[] = {"infinite", "finite", NULL};
 enum { SV_METHOD, SV_EXTRUSION, SV_DISTANCE, SV_OFFSET };
-enum { METHOD_ZPASS, METHOD_ZFAIL };
+enum { METHOD_ZPASS, METHOD_ZFAIL, METHOD_ZPPLUS };
 enum { EXTRUDE_INFINITE, EXTRUDE_FINITE };
 
 static const ParamDesc sv_params[] = {
-    {"method", PARAM_ENUM, METHOD_ZFAIL, 0, 1, "",
+    {"method", PARAM_ENUM, METHOD_ZFAIL, 0, 2, "",
      "zpass: count volume faces in front of the sample (Heidmann 1991; wrong where the camera is inside a volume, "
-     "whose faces the near plane clips); zfail: count those behind it, volumes capped (Carmack's reverse)",
+     "whose faces the near plane clips); zfail: count those behind it, volumes capped (Carmack's reverse); zpplus: "
+     "z-pass from counts that start at the near plane's, the near caps projected from the light's centre onto it "
+     "(ZP+, Hornus et al. 2005)",
      method_names},
     {"extrusion", PARAM_ENUM, EXTRUDE_INFINITE, 0, 1, "",
      "infinite: silhouette quads and far cap at infinity (homogeneous w = 0, Everitt & Kilgard 2002); finite: "
@@ -97,18 +101,26 @@ static void push_quad(Volume *v, const Extrude *e, const SilEdge *s)
     push_tri(v, base, base + 2, base + 3, (int16_t)s->count);
 }
 
+/* Which parts of the volume a method draws. */
+enum { PART_SIDES = 1, PART_NEAR_CAPS = 2, PART_FAR_CAPS = 4 };
+
 /* Near cap (a, b, c) turned toward the centre, and the far cap (c', b', a'). */
-static void push_caps(Volume *v, const Extrude *e, vec3 a, vec3 b, vec3 c)
+static void push_caps(Volume *v, const Extrude *e, vec3 a, vec3 b, vec3 c, unsigned parts)
 {
     uint32_t base = (uint32_t)v->nv;
-    push_point(v, a);
-    push_point(v, b);
-    push_point(v, c);
-    push_extruded(v, e, a);
-    push_extruded(v, e, b);
-    push_extruded(v, e, c);
-    push_tri(v, base, base + 1, base + 2, 1);
-    push_tri(v, base + 5, base + 4, base + 3, 1);
+    if (parts & PART_NEAR_CAPS) {
+        push_point(v, a);
+        push_point(v, b);
+        push_point(v, c);
+        push_tri(v, base, base + 1, base + 2, 1);
+        base += 3;
+    }
+    if (parts & PART_FAR_CAPS) {
+        push_extruded(v, e, a);
+        push_extruded(v, e, b);
+        push_extruded(v, e, c);
+        push_tri(v, base + 2, base + 1, base, 1);
+    }
 }
 
 static void volume_free(Volume *v)
@@ -119,16 +131,19 @@ static void volume_free(Volume *v)
     free(v->count);
 }
 
-static bool volume_build(const Scene *scene, const Silhouette *sil, const Extrude *e, bool caps, Volume *v, Error *err)
+static bool volume_build(const Scene *scene, const Silhouette *sil, const Extrude *e, unsigned parts, Volume *v,
+                         Error *err)
 {
-    long quads = sil->num_edges, cap_tris = 0;
+    bool caps = parts & (PART_NEAR_CAPS | PART_FAR_CAPS);
+    int cap_parts = ((parts & PART_NEAR_CAPS) != 0) + ((parts & PART_FAR_CAPS) != 0);
+    long quads = parts & PART_SIDES ? sil->num_edges : 0, cap_tris = 0;
     for (int i = 0; caps && i < sil->num_objects; i++)
         for (int t = 0; t < sil->objects[i].triangles; t++) cap_tris += sil->objects[i].weight[t] != 0;
     for (int i = 0; i < sil->num_edges; i++)
         if (sil->edges[i].count > INT16_MAX)
             return error_set(err, "shadow_volume: an edge of object '%s' is extruded %d times (at most %d)",
                              scene->objects[sil->edges[i].object].name, sil->edges[i].count, INT16_MAX);
-    long nv = 4 * quads + 6 * cap_tris, nt = 2 * quads + 2 * cap_tris;
+    long nv = 4 * quads + 3L * cap_parts * cap_tris, nt = 2 * quads + (long)cap_parts * cap_tris;
     if (nv >= INT32_MAX || nt >= INT32_MAX / 3)
         return error_set(err, "shadow_volume: %ld volume triangles exceed the rasterizer's range", nt);
     memset(v, 0, sizeof *v);
@@ -140,7 +155,7 @@ static bool volume_build(const Scene *scene, const Silhouette *sil, const Extrud
         volume_free(v);
         return error_set(err, "out of memory for %ld shadow-volume triangles", nt);
     }
-    for (int i = 0; i < sil->num_edges; i++) push_quad(v, e, &sil->edges[i]);
+    for (int i = 0; i < quads; i++) push_quad(v, e, &sil->edges[i]);
     for (int i = 0; caps && i < sil->num_objects; i++) {
         const SilObject *so = &sil->objects[i];
         const Mesh *m = &scene->objects[so->object].mesh;
@@ -148,8 +163,8 @@ static bool volume_build(const Scene *scene, const Silhouette *sil, const Extrud
             if (!so->weight[t]) continue;
             const uint32_t *ix = &m->indices[3 * t];
             vec3 a = m->positions[ix[0]], b = m->positions[ix[1]], c = m->positions[ix[2]];
-            if (so->weight[t] > 0) push_caps(v, e, a, b, c);
-            else push_caps(v, e, a, c, b);
+            if (so->weight[t] > 0) push_caps(v, e, a, b, c, parts);
+            else push_caps(v, e, a, c, b, parts);
         }
     }
     return true;
@@ -188,7 +203,8 @@ static float *test_depths(const TechContext *ctx, double offset_scale)
     return d;
 }
 
-static bool count_volumes(const TechContext *ctx, const Volume *v, int method, int32_t *out, Error *err)
+static bool count_volumes(const TechContext *ctx, const Volume *v, const Volume *near_caps, const double L[4],
+                          int method, int32_t *out, Error *err)
 {
     float *depth = test_depths(ctx, ctx->params[SV_OFFSET]);
     if (!depth) return error_set(err, "out of memory for %d test depths", ctx->vs->count);
@@ -198,13 +214,18 @@ static bool count_volumes(const TechContext *ctx, const Volume *v, int method, i
     if (!ok) return false;
     RasterMesh mesh = {v->p, v->ix, v->nv, v->nt};
     RasterMeshExtra extra = {v->w, v->count};
-    CountTest test = method == METHOD_ZPASS ? COUNT_NEARER : COUNT_FARTHER;
-    ok = camera_count_render(&cc, &mesh, &extra, 1, test, NULL, err);
+    CountTest test = method == METHOD_ZFAIL ? COUNT_FARTHER : COUNT_NEARER;
+    if (near_caps) {
+        RasterMesh caps = {near_caps->p, near_caps->ix, near_caps->nv, near_caps->nt};
+        RasterMeshExtra caps_extra = {near_caps->w, near_caps->count};
+        ok = camera_count_near_caps(&cc, &ctx->scene->camera, &caps, &caps_extra, L, NULL, err);
+    }
+    ok = ok && camera_count_render(&cc, &mesh, &extra, 1, test, NULL, err);
     /* z-pass counts entries minus exits in front of p; z-fail the exits
      * minus entries behind it: the same number with the faces' signs turned */
     for (int s = 0; ok && s < ctx->vs->count; s++) {
         int32_t c = camera_count_at(&cc, s);
-        out[s] = method == METHOD_ZPASS ? c : c == INT32_MIN ? INT32_MAX : -c;
+        out[s] = method != METHOD_ZFAIL ? c : c == INT32_MIN ? INT32_MAX : -c;
     }
     camera_count_free(&cc);
     return ok;
@@ -217,12 +238,19 @@ static bool sv_prepare(const TechContext *ctx, void **state, Error *err)
     int method = (int)ctx->params[SV_METHOD];
     Extrude e = {{sil->light[0], sil->light[1], sil->light[2], sil->light[3]},
                  (int)ctx->params[SV_EXTRUSION] == EXTRUDE_INFINITE, (float)ctx->params[SV_DISTANCE]};
-    Volume v;
-    if (!volume_build(ctx->scene, sil, &e, method == METHOD_ZFAIL, &v, err)) return false;
+    Volume v, near_caps = {0};
+    unsigned parts = method == METHOD_ZFAIL ? PART_SIDES | PART_NEAR_CAPS | PART_FAR_CAPS : PART_SIDES;
+    if (!volume_build(ctx->scene, sil, &e, parts, &v, err)) return false;
+    if (method == METHOD_ZPPLUS && !volume_build(ctx->scene, sil, &e, PART_NEAR_CAPS, &near_caps, err)) {
+        volume_free(&v);
+        return false;
+    }
     SvState *st = malloc(sizeof *st);
     int32_t *count = malloc(sizeof *count * (size_t)ctx->vs->count);
-    bool ok = st && count && count_volumes(ctx, &v, method, count, err);
+    bool ok = st && count &&
+              count_volumes(ctx, &v, method == METHOD_ZPPLUS ? &near_caps : NULL, sil->light, method, count, err);
     volume_free(&v);
+    volume_free(&near_caps);
     if (!ok) {
         if (!st || !count) error_set(err, "out of memory for %d shadow-volume counts", ctx->vs->count);
         free(st);

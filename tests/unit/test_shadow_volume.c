@@ -3,7 +3,7 @@
  * agrees except samples within a stated tolerance of a shadow-volume side
  * face, each counted and checked; with the camera inside the ball's shadow
  * z-pass (whose near plane clips the volume) is measured to fail and z-fail
- * stays right; the counting pass refuses a counter leaving int32. About 1 s. */
+ * and ZP+ stay right; the counting pass refuses a counter leaving int32. About 1 s. */
 #include <stdlib.h>
 #include <string.h>
 #include "fixtures.h"
@@ -141,6 +141,11 @@ TEST(test_shadow_volume_zpass_equals_hard_with_the_camera_outside)
     zfail_equals_hard("sphere-on-plane.lua", NULL, 0, "method=zpass");
 }
 
+TEST(test_shadow_volume_zpplus_equals_hard_with_the_camera_outside)
+{
+    zfail_equals_hard("sphere-on-plane.lua", NULL, 0, "method=zpplus");
+}
+
 TEST(test_shadow_volume_zfail_equals_hard_at_contacts)
 {
     zfail_equals_hard("contact.lua", NULL, 0, "method=zfail");
@@ -159,19 +164,25 @@ TEST(test_shadow_volume_camera_inside_a_volume_zpass_fails_zfail_holds)
     const char *inside[] = {"camera.position={-0.27,0.28,-0.18}", "camera.target={2,0,2}"};
     Lab *lab = open_small("sphere-on-plane.lua", inside, 2);
     CHECK(lab);
-    RenderResult hard, zpass, zfail;
+    RenderResult hard, zpass, zfail, zpplus;
     CHECK(render(lab, "hard", NULL, &hard));
     CHECK(render(lab, "shadow_volume", "method=zpass", &zpass));
     CHECK(render(lab, "shadow_volume", "method=zfail", &zfail));
+    CHECK(render(lab, "shadow_volume", "method=zpplus", &zpplus));
     Agreement p = agreement(lab, &zpass.visibility, &hard.visibility);
     Agreement f = agreement(lab, &zfail.visibility, &hard.visibility);
+    Agreement z = agreement(lab, &zpplus.visibility, &hard.visibility);
     print_agreement("camera inside, zpass", &p);
     print_agreement("camera inside, zfail", &f);
+    print_agreement("camera inside, zpplus", &z);
     CHECK(p.candidates > 1000);
     /* the near plane cuts the volume the camera is in: every count is one short */
     CHECK_MSG(p.disagree * 2 > p.candidates, "z-pass disagrees on only %ld of %ld", p.disagree, p.candidates);
     CHECK(f.within == f.disagree);
     CHECK(f.disagree * 100 < f.candidates);
+    CHECK(z.within == z.disagree);
+    CHECK(z.disagree * 100 < z.candidates);
+    render_result_free(&zpplus);
     render_result_free(&hard);
     render_result_free(&zpass);
     render_result_free(&zfail);
