@@ -282,7 +282,7 @@ static void sv_release(void *state)
 const Technique tech_shadow_volume = {
     .name = "shadow_volume",
     .family = "geometry",
-    .source = "course §2.2 (Crow 1977; z-pass Heidmann 1991; z-fail Bilodeau & Songy 1999; open meshes Bergeron 1986)",
+    .source = "course §2.2 (Crow 1977; z-pass Heidmann 1991; z-fail Bilodeau & Songy 1999; ZP+ Hornus et al. 2005; open meshes Bergeron 1986)",
     .summary = "shadow volumes from the light's centre: silhouette quads (and caps) counted per view sample in camera "
                "space, shadowed where the count is not zero",
     .params = sv_params,
