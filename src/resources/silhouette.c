@@ -2,6 +2,7 @@
  * light's centre (see silhouette.h). Welding and edges use open-addressing
  * hash tables, so the build is linear in the triangles. */
 #include "resources/silhouette.h"
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -223,17 +224,33 @@ Silhouette *silhouette_build(const Scene *scene, int light_index, Error *err)
     return sil;
 }
 
+/* printf at out + *used, advancing *used (at most to n). */
+static void append(char *out, size_t n, size_t *used, const char *fmt, ...) __attribute__((format(printf, 4, 5)));
+static void append(char *out, size_t n, size_t *used, const char *fmt, ...)
+{
+    if (*used >= n) return;
+    va_list ap;
+    va_start(ap, fmt);
+    int k = vsnprintf(out + *used, n - *used, fmt, ap);
+    va_end(ap);
+    *used = k < 0 ? n : *used + (size_t)k < n ? *used + (size_t)k : n;
+}
+
 void silhouette_report(const Silhouette *sil, const Scene *scene, char *out, size_t n)
 {
     size_t used = 0;
     out[0] = '\0';
-    for (int i = 0; i < sil->num_objects && used < n; i++) {
+    for (int i = 0; i < sil->num_objects; i++) {
         const SilObject *so = &sil->objects[i];
         if (so->closed && so->degenerate == 0) continue;
-        used += (size_t)snprintf(out + used, n - used,
-                                 "%s'%s': %ld open, %ld non-manifold, %ld misoriented edges, %d degenerate triangles",
-                                 used ? "; " : "", scene->objects[so->object].name, so->open_edges,
-                                 so->nonmanifold_edges, so->misoriented_edges, so->degenerate);
+        static const char *const what[3] = {"open", "non-manifold", "misoriented"};
+        const long counts[3] = {so->open_edges, so->nonmanifold_edges, so->misoriented_edges};
+        int parts = 0;
+        append(out, n, &used, "%s'%s':", used ? "; " : "", scene->objects[so->object].name);
+        for (int k = 0; k < 3; k++)
+            if (counts[k]) append(out, n, &used, "%s %ld %s", parts++ ? "," : "", counts[k], what[k]);
+        if (parts) append(out, n, &used, " edges");
+        if (so->degenerate) append(out, n, &used, "%s %d zero-area triangles skipped", parts ? "," : "", so->degenerate);
     }
 }
 
@@ -271,6 +288,10 @@ const Silhouette *res_silhouette(ResourceManager *rm, const Scene *scene, int li
     snprintf(desc, sizeof desc, "casters, centre of light %d", light_index + 1);
     SilArgs a = {scene, light_index};
     Silhouette *sil = rm_acquire(rm, &kind_silhouette, key, desc, build_sil, &a, err);
-    if (sil) sil->key = key;
+    if (!sil) return NULL;
+    sil->key = key;
+    char report[512];
+    silhouette_report(sil, scene, report, sizeof report);
+    if (report[0]) rm_log_note(rm, kind_silhouette.name, key, report); /* the objects that are not closed, by name */
     return sil;
 }

@@ -65,9 +65,10 @@ const Silhouette *res_silhouette(ResourceManager *rm, const Scene *scene, int li
 Silhouette *silhouette_build(const Scene *scene, int light_index, Error *err);
 void silhouette_free(Silhouette *sil);
 
-/* "name: 12 open, 0 non-manifold, 0 misoriented edges, 2 degenerate
- * triangles" for each object that is not closed or skipped triangles, or ""
- * when every caster is a closed 2-manifold. */
+/* "'name': 12 open, 1 non-manifold edges, 2 zero-area triangles skipped"
+ * (counts that are 0 left out) for each object that is not closed or
+ * skipped triangles, "; " between them, or "" when every caster is a closed
+ * 2-manifold without zero-area triangles. */
 void silhouette_report(const Silhouette *sil, const Scene *scene, char *out, size_t n);
 
 #endif

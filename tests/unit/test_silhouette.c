@@ -102,7 +102,7 @@ TEST(test_silhouette_open_plane_extrudes_its_border_from_either_side)
     CHECK(silhouette_is_a_cycle(sil));
     char report[256];
     silhouette_report(sil, lab_scene(lab), report, sizeof report);
-    CHECK_MSG(strstr(report, "'ground': 4 open, 0 non-manifold") != NULL, "report: %s", report);
+    CHECK_MSG(strcmp(report, "'ground': 4 open edges") == 0, "report: %s", report);
     /* from below, the triangles count turned toward the light: the same border, reversed */
     vec3 a = sil->edges[0].a, b = sil->edges[0].b;
     silhouette_free(sil);
@@ -137,7 +137,7 @@ TEST(test_silhouette_counts_non_manifold_and_degenerate_triangles)
     CHECK(silhouette_is_a_cycle(sil));
     char report[256];
     silhouette_report(sil, lab_scene(lab), report, sizeof report);
-    CHECK_MSG(strstr(report, "'fan': 6 open, 1 non-manifold, 0 misoriented edges, 1 degenerate") != NULL, "report: %s",
+    CHECK_MSG(strcmp(report, "'fan': 6 open, 1 non-manifold edges, 1 zero-area triangles skipped") == 0, "report: %s",
               report);
     silhouette_free(sil);
     lab_close(lab);
