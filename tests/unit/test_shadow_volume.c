@@ -239,3 +239,35 @@ TEST(test_shadow_volume_zfail_equals_hard_on_the_bunny)
     }
     zfail_equals_hard("bunny.lua", NULL, 0, "method=zfail");
 }
+
+/* A finite extrusion shorter than the ball's height above the ground (0.4)
+ * leaves the ground's shadow out: the volume ends before it. */
+TEST(test_shadow_volume_short_finite_extrusion_stops_before_the_ground)
+{
+    Lab *lab = open_small("sphere-on-plane.lua", NULL, 0);
+    CHECK(lab);
+    RenderResult hard, short_sv;
+    CHECK(render(lab, "hard", NULL, &hard));
+    Error err;
+    const Technique *t = tech_find("shadow_volume", &err);
+    double params[TECH_MAX_PARAMS];
+    tech_params_default(t, params);
+    CHECK(tech_param_parse(t, "extrusion=finite", params, &err) && tech_param_parse(t, "distance=0.1", params, &err));
+    RenderRequest rq = {.tech = t, .params = params, .light_index = 0, .repeat = 1};
+    CHECK(lab_render(lab, &rq, &short_sv, &err));
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    CHECK(vs && cls);
+    long ground_shadow = 0, short_lit = 0;
+    for (int s = 0; s < vs->count; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE || strcmp(lab_scene(lab)->objects[vs->object[s]].name, "ground") != 0) continue;
+        if (hard.visibility.data[(size_t)s * hard.visibility.channels] > 0.5f) continue;
+        ground_shadow++;
+        short_lit += short_sv.visibility.data[(size_t)s * short_sv.visibility.channels] > 0.5f;
+    }
+    printf("    %ld ground samples shadowed by hard, %ld of them lit with distance=0.1\n", ground_shadow, short_lit);
+    CHECK(ground_shadow > 100 && short_lit == ground_shadow);
+    render_result_free(&hard);
+    render_result_free(&short_sv);
+    lab_close(lab);
+}
