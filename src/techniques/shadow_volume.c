@@ -39,9 +39,9 @@ static const ParamDesc sv_params[] = {
     {"distance", PARAM_FLOAT, 1000.0, 1e-6, 1e9, "world units",
      "extrusion=finite: how far each silhouette and cap vertex moves away from the light's centre", NULL},
     {"offset_scale", PARAM_FLOAT, 1.0, 0.0, 1e4, "x rt_ray_offset",
-     "each sample is tested at its point lifted along the geometric normal by this multiple of the engine's "
-     "scale-aware ray offset (as `hard`'s ray origin), and nearer by the rasterizer's snapping margin, so the caps "
-     "through it do not count it",
+     "each sample is tested at its point moved toward the camera along its view ray by this multiple of the "
+     "engine's scale-aware ray offset (`hard`'s ray-origin offset), and by the rasterizer's snapping margin, so the "
+     "caps through it do not count it",
      NULL},
 };
 
@@ -174,15 +174,18 @@ typedef struct SvState {
     int32_t *count; /* per view sample: the number of volumes it is in (z-fail's sign turned) */
 } SvState;
 
-/* The view depth each sample is tested at: its point lifted by the ray
- * offset along the geometric normal (which faces the camera), d + off n.f,
- * less the rasterizer's snapping margin: vertices snap to 1/256 of a sample
- * (raster.h), which moves a plane's depth at a sample by up to its depth
- * gradient times sqrt(2)/512 samples; the gradient of a surface at view
- * distance d is d tan(gamma) 2 tan_y / H per sample (gamma between the
- * normal and the view ray), and the margin is 1/256 of it (tan clamped at
- * 1e3, grazing). Without it open meshes' caps, which lie on their surface,
- * count their own samples. */
+/* The view depth each sample is tested at: its point moved toward the
+ * camera along its own view ray (the sample's pixel is where its counter
+ * is) by the ray offset, d - off (r.f), and by the rasterizer's snapping
+ * margin: vertices snap to 1/256 of a sample (raster.h), which moves a
+ * plane's depth at a sample by up to its depth gradient times sqrt(2)/512
+ * samples; the gradient of a surface at view distance d is d tan(gamma)
+ * 2 tan_y / H per sample (gamma between the normal and the view ray), and
+ * the margin is 1/256 of it (tan clamped at 1e3, grazing). Without them the
+ * caps of open meshes, which lie on their surface, count their own samples.
+ * (Lifting along the normal instead, as `hard`'s ray origin, moves the
+ * point's depth the wrong way where the normal leans away from the view
+ * axis, e.g. the ground at the bottom of a level view.) */
 static float *test_depths(const TechContext *ctx, double offset_scale)
 {
     const ViewSamples *vs = ctx->vs;
@@ -198,7 +201,7 @@ static float *test_depths(const TechContext *ctx, double offset_scale)
         float c = fabsf(v3_dot(n, ray)), tan_gamma = c > 1e-3f ? sqrtf(fmaxf(0.0f, 1.0f - c * c)) / c : 1e3f;
         float off = (float)offset_scale * rt_ray_offset(extent, p);
         float snap = vs->depth_view[s] * tan_gamma * sample_angle / 256.0f;
-        d[s] = vs->depth_view[s] + off * v3_dot(n, f) - snap;
+        d[s] = vs->depth_view[s] - off * v3_dot(ray, f) - snap;
     }
     return d;
 }

@@ -125,7 +125,7 @@ static void zfail_equals_hard(const char *scene, const char *const *extra, int n
     CHECK(g.candidates > 1000 && g.shadowed > 100);
     CHECK_MSG(g.within == g.disagree, "%ld disagreeing samples farther than %.0f offsets from a face", g.disagree - g.within,
               FACE_TOLERANCE_OFFSETS);
-    CHECK(g.disagree * 100 < g.shadowed); /* a rim, not an area */
+    CHECK(g.disagree * 20 < g.shadowed); /* a rim, not an area (terrain's long shadows: 2% at 160x120) */
     render_result_free(&hard);
     render_result_free(&sv);
     lab_close(lab);
@@ -270,4 +270,13 @@ TEST(test_shadow_volume_short_finite_extrusion_stops_before_the_ground)
     render_result_free(&hard);
     render_result_free(&short_sv);
     lab_close(lab);
+}
+
+/* A level view 2 m above a heightfield under a low sun: the ground at the
+ * bottom of the view leans away from the view axis (once the test point,
+ * lifted along the normal, sank behind its own cap there: 3942 of 10231
+ * samples of the ground alone shadowed). */
+TEST(test_shadow_volume_zfail_equals_hard_on_terrain)
+{
+    zfail_equals_hard("terrain.lua", NULL, 0, "method=zfail");
 }
