@@ -12,8 +12,10 @@
  * zero means shadow (course §2.2 [OWN] correction: overlapping volumes give
  * counts >= 2). Every light kind is shadowed from its centre, as `hard`. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/hash.h"
 #include "raster/camera_count.h"
 #include "resources/silhouette.h"
 #include "resources/standard.h"
@@ -45,7 +47,7 @@ static const ParamDesc sv_params[] = {
      NULL},
 };
 
-static const char *const sv_resources[] = {"silhouette", NULL};
+static const char *const sv_resources[] = {"silhouette", "shadow_volume_counts", NULL};
 static const char *const sv_aux[] = {"count", NULL};
 
 /* The volume as one homogeneous mesh with a signed count per triangle. */
@@ -170,9 +172,14 @@ static bool volume_build(const Scene *scene, const Silhouette *sil, const Extrud
     return true;
 }
 
-typedef struct SvState {
-    int32_t *count; /* per view sample: the number of volumes it is in (z-fail's sign turned) */
-} SvState;
+/* The counts: per view sample, the number of volumes it is in (z-fail's
+ * sign turned). A frame resource keyed by the silhouette, the view samples
+ * and the parameters that shape the volume, so `--repeat` times its builds
+ * (the volume and the camera pass) as it times a shadow map's. */
+typedef struct SvCounts {
+    int n;
+    int32_t *count;
+} SvCounts;
 
 /* The view depth each sample is tested at: its point moved toward the
  * camera along its own view ray (the sample's pixel is where its counter
@@ -234,52 +241,84 @@ static bool count_volumes(const TechContext *ctx, const Volume *v, const Volume 
     return ok;
 }
 
+static size_t counts_bytes(const void *res) { return sizeof(SvCounts) + sizeof(int32_t) * (size_t)((const SvCounts *)res)->n; }
+
+static void counts_destroy(void *res)
+{
+    SvCounts *c = res;
+    free(c->count);
+    free(c);
+}
+
+static const ResourceKind kind_counts = {"shadow_volume_counts", counts_bytes, counts_destroy, RES_FRAME};
+
+typedef struct CountArgs {
+    const TechContext *ctx;
+    const Silhouette *sil;
+} CountArgs;
+
+static void *build_counts(const void *args, Error *err)
+{
+    const CountArgs *a = args;
+    const TechContext *ctx = a->ctx;
+    int method = (int)ctx->params[SV_METHOD];
+    Extrude e = {{a->sil->light[0], a->sil->light[1], a->sil->light[2], a->sil->light[3]},
+                 (int)ctx->params[SV_EXTRUSION] == EXTRUDE_INFINITE, (float)ctx->params[SV_DISTANCE]};
+    Volume v, near_caps = {0};
+    unsigned parts = method == METHOD_ZFAIL ? PART_SIDES | PART_NEAR_CAPS | PART_FAR_CAPS : PART_SIDES;
+    if (!volume_build(ctx->scene, a->sil, &e, parts, &v, err)) return NULL;
+    if (method == METHOD_ZPPLUS && !volume_build(ctx->scene, a->sil, &e, PART_NEAR_CAPS, &near_caps, err)) {
+        volume_free(&v);
+        return NULL;
+    }
+    SvCounts *c = malloc(sizeof *c);
+    int32_t *count = malloc(sizeof *count * (size_t)ctx->vs->count);
+    bool ok = c && count &&
+              count_volumes(ctx, &v, method == METHOD_ZPPLUS ? &near_caps : NULL, a->sil->light, method, count, err);
+    if (!c || !count) error_set(err, "out of memory for %d shadow-volume counts", ctx->vs->count);
+    volume_free(&v);
+    volume_free(&near_caps);
+    if (!ok) {
+        free(c);
+        free(count);
+        return NULL;
+    }
+    *c = (SvCounts){ctx->vs->count, count};
+    return c;
+}
+
 static bool sv_prepare(const TechContext *ctx, void **state, Error *err)
 {
     const Silhouette *sil = res_silhouette(ctx->rm, ctx->scene, ctx->light_index, err);
     if (!sil) return false;
-    int method = (int)ctx->params[SV_METHOD];
-    Extrude e = {{sil->light[0], sil->light[1], sil->light[2], sil->light[3]},
-                 (int)ctx->params[SV_EXTRUSION] == EXTRUDE_INFINITE, (float)ctx->params[SV_DISTANCE]};
-    Volume v, near_caps = {0};
-    unsigned parts = method == METHOD_ZFAIL ? PART_SIDES | PART_NEAR_CAPS | PART_FAR_CAPS : PART_SIDES;
-    if (!volume_build(ctx->scene, sil, &e, parts, &v, err)) return false;
-    if (method == METHOD_ZPPLUS && !volume_build(ctx->scene, sil, &e, PART_NEAR_CAPS, &near_caps, err)) {
-        volume_free(&v);
-        return false;
-    }
-    SvState *st = malloc(sizeof *st);
-    int32_t *count = malloc(sizeof *count * (size_t)ctx->vs->count);
-    bool ok = st && count &&
-              count_volumes(ctx, &v, method == METHOD_ZPPLUS ? &near_caps : NULL, sil->light, method, count, err);
-    volume_free(&v);
-    volume_free(&near_caps);
-    if (!ok) {
-        if (!st || !count) error_set(err, "out of memory for %d shadow-volume counts", ctx->vs->count);
-        free(st);
-        free(count);
-        return false;
-    }
-    st->count = count;
-    *state = st;
-    return true;
+    bool finite = (int)ctx->params[SV_EXTRUSION] == EXTRUDE_FINITE;
+    Hasher h;
+    hash_init(&h);
+    hash_str(&h, "shadow volume counts 1");
+    hash_u64(&h, sil->key);
+    hash_u64(&h, ctx->scene->hash_geometry); /* the view samples: geometry and camera */
+    hash_u64(&h, ctx->scene->hash_camera);
+    hash_f64(&h, ctx->params[SV_METHOD]);
+    hash_f64(&h, ctx->params[SV_EXTRUSION]);
+    hash_f64(&h, finite ? ctx->params[SV_DISTANCE] : 0.0); /* only a finite extrusion reads it */
+    hash_f64(&h, ctx->params[SV_OFFSET]);
+    char desc[160];
+    snprintf(desc, sizeof desc, "light %d, %s, %s extrusion, %dx%d samples", ctx->light_index + 1,
+             method_names[(int)ctx->params[SV_METHOD]], extrusion_names[finite], ctx->vs->width, ctx->vs->height);
+    CountArgs a = {ctx, sil};
+    const SvCounts *c = rm_acquire(ctx->rm, &kind_counts, hash_final(&h), desc, build_counts, &a, err);
+    *state = (void *)c;
+    return c != NULL;
 }
 
 static void sv_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
 {
-    const SvState *st = state;
+    const SvCounts *st = state;
     for (int s = begin; s < end; s++) {
         if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
         tech_store(ctx, out, begin, s, st->count[s] != 0 ? 0.0f : 1.0f); /* count != 0: shadowed */
         if (ctx->aux) ctx->aux[s] = (float)st->count[s];
     }
-}
-
-static void sv_release(void *state)
-{
-    SvState *st = state;
-    if (st) free(st->count);
-    free(st);
 }
 
 const Technique tech_shadow_volume = {
@@ -296,6 +335,6 @@ const Technique tech_shadow_volume = {
     .main_param = "method",
     .prepare = sv_prepare,
     .evaluate = sv_evaluate,
-    .release = sv_release,
+    .release = NULL, /* the state is the counts resource, which the manager owns */
     .aux = sv_aux,
 };
