@@ -5,7 +5,8 @@
  *   3. binning: prefix sums give every tile a list of triangles in input
  *      order (chunks are contiguous, so the order is deterministic);
  *   4. tiles in parallel: per row, the exact span the three edge functions
- *      allow (integer arithmetic), then a vectorised depth loop over it.
+ *      allow (integer arithmetic), then a vectorised depth loop over it (or,
+ *      for the counting tests, a loop adding the triangle's signed count).
  * Edge functions are integers below 2^47 (8 sub-texel bits, maps up to
  * 16384^2), evaluated in int64. */
 #include "raster/raster.h"
@@ -40,6 +41,7 @@ typedef struct SnapTri {
     double f[3];        /* value (or a/w) at the vertices */
     double q[3];        /* 1/w at the vertices (VALUE_PERSPECTIVE) */
     int32_t id;
+    int32_t count;          /* counting tests: +count front-facing (counter-clockwise before orienting), -count back */
     int32_t i0, j0, i1, j1; /* covered texel range, inclusive */
     bool small;             /* vertex box within SMALL_W x SMALL_H texels: fill_small's int32 edges are exact */
 } SnapTri;
@@ -175,21 +177,23 @@ void raster_scratch_free(RasterScratch *scratch)
     free(scratch);
 }
 
-static void transform_vertices(const Setup *s, const RasterMesh *m, Vertices *out)
+static void transform_vertices(const Setup *s, const RasterMesh *m, const RasterMeshExtra *extra, Vertices *out)
 {
+    const float *weights = extra ? extra->weights : NULL;
     const RasterView *v = s->view;
     const double *r = v->depth_row;
     ClipPlanes planes = v->mapping == RASTER_PARABOLOID ? CLIP_FRONT_ONLY : CLIP_FRUSTUM;
 #pragma omp parallel for schedule(dynamic, 2048)
     for (int i = 0; i < m->num_vertices; i++) {
         dvec3 p = d3_from(m->positions[i]);
-        dvec4 c = m4_apply(&v->clip_from_world, p);
+        double h = weights ? weights[i] : 1.0; /* homogeneous (p, h) */
+        dvec4 c = m4_apply4(&v->clip_from_world, (dvec4){p.x, p.y, p.z, h});
         RVertex *o = &out->v[i];
         ClipVertex *cv = &out->clip[i];
         if (v->mapping == RASTER_PARABOLOID) /* light view space, front = -z: clip z = -z_view >= 0 */
             *cv = (ClipVertex){c.x, c.y, -c.z, 1.0, 0.0};
         else
-            *cv = (ClipVertex){c.x, c.y, c.z, c.w, r[0] * p.x + r[1] * p.y + r[2] * p.z + r[3]};
+            *cv = (ClipVertex){c.x, c.y, c.z, c.w, r[0] * p.x + r[1] * p.y + r[2] * p.z + r[3] * h};
         *o = (RVertex){clip_outcode(cv, planes), 0, 0, 0.0, 0.0};
         ScreenVertex sv;
         if (o->outcode) continue;
@@ -249,7 +253,7 @@ static int64_t area2(const int32_t *x, const int32_t *y, int a, int b, int c)
 
 /* Fan the snapped polygon into counter-clockwise triangles. */
 static bool emit_polygon(const Setup *s, const int32_t *x, const int32_t *y, const double *f, const double *q, int n,
-                         int32_t id, ThreadTris *tt, bool *culled)
+                         int32_t id, int32_t count, ThreadTris *tt, bool *culled)
 {
     int64_t area = 0;
     for (int k = 1; k + 1 < n; k++) area += area2(x, y, 0, k, k + 1);
@@ -270,6 +274,7 @@ static bool emit_polygon(const Setup *s, const int32_t *x, const int32_t *y, con
             t.q[v] = q[idx[v]];
         }
         t.id = id;
+        t.count = area > 0 ? count : -count;
         if (texel_range(s, &t)) {
             if (!push_tri(tt, &t)) return false;
             count_tiles(s, &t, tt->tile_count);
@@ -280,7 +285,7 @@ static bool emit_polygon(const Setup *s, const int32_t *x, const int32_t *y, con
 
 /* A triangle that crosses frustum planes: clip, project and snap its polygon. */
 static bool emit_clipped(const Setup *s, const ClipVertex *clip, const uint32_t *ix, unsigned crossing, int32_t id,
-                         ThreadTris *tt, bool *culled)
+                         int32_t count, ThreadTris *tt, bool *culled)
 {
     const ClipVertex tri[3] = {clip[ix[0]], clip[ix[1]], clip[ix[2]]};
     ClipVertex poly[CLIP_MAX_VERTS];
@@ -296,10 +301,11 @@ static bool emit_clipped(const Setup *s, const ClipVertex *clip, const uint32_t 
         q[k] = sv.q;
     }
     *culled = n < 3;
-    return *culled || emit_polygon(s, x, y, f, q, n, id, tt, culled);
+    return *culled || emit_polygon(s, x, y, f, q, n, id, count, tt, culled);
 }
 
-static bool setup_triangle(const Setup *s, const Vertices *vx, const uint32_t *ix, int32_t id, ThreadTris *tt)
+static bool setup_triangle(const Setup *s, const Vertices *vx, const uint32_t *ix, int32_t id, int32_t count,
+                           ThreadTris *tt)
 {
     const RVertex *v[3] = {&vx->v[ix[0]], &vx->v[ix[1]], &vx->v[ix[2]]};
     unsigned all = v[0]->outcode & v[1]->outcode & v[2]->outcode, any = v[0]->outcode | v[1]->outcode | v[2]->outcode;
@@ -308,11 +314,11 @@ static bool setup_triangle(const Setup *s, const Vertices *vx, const uint32_t *i
     bool ok;
     if (any) {
         tt->clipped++;
-        ok = emit_clipped(s, vx->clip, ix, any, id, tt, &culled);
+        ok = emit_clipped(s, vx->clip, ix, any, id, count, tt, &culled);
     } else {
         const int32_t x[3] = {v[0]->x, v[1]->x, v[2]->x}, y[3] = {v[0]->y, v[1]->y, v[2]->y};
         const double f[3] = {v[0]->f, v[1]->f, v[2]->f}, q[3] = {v[0]->q, v[1]->q, v[2]->q};
-        ok = emit_polygon(s, x, y, f, q, 3, id, tt, &culled);
+        ok = emit_polygon(s, x, y, f, q, 3, id, count, tt, &culled);
     }
     tt->culled += ok && culled;
     return ok;
@@ -370,6 +376,10 @@ typedef struct Target {
     const float *peel;
     int stride;
     bool farthest, perspective, conservative;
+    int32_t *count;         /* counting tests: counters and reference values at j * stride + i */
+    const float *count_ref;
+    bool count_less;        /* RASTER_COUNT_LESS (else GREATER) */
+    long *overflow;         /* updates refused because the counter would leave int32 */
 } Target;
 
 static inline float *tile_row(const Target *T, int j, int i) { return T->depth + (size_t)(j - T->tj0) * TILE + (i - T->ti0); }
@@ -438,7 +448,27 @@ static int span_nearest(float *d, int n, float f_row, float fs, float q_row, flo
     return written;
 }
 
-static long fill_span(const Fill *F, const Target *T, int32_t id, int j, int i0, int i1)
+/* A counting test's span: fragments that pass add inc to their counter,
+ * unless it would leave int32 (then *overflow counts the update). */
+static long count_span(const Target *T, int32_t inc, size_t row, int n, float f_row, float fs, float q_row, float qs)
+{
+    int32_t *c = T->count + row;
+    const float *ref = T->count_ref + row;
+    long counted = 0;
+    for (int i = 0; i < n; i++) {
+        float v = span_value(f_row, fs, q_row, qs, (float)i, T->perspective);
+        if (T->count_less ? !(v < ref[i]) : !(v > ref[i])) continue;
+        if (inc > 0 ? c[i] > INT32_MAX - inc : c[i] < INT32_MIN - inc) {
+            (*T->overflow)++;
+            continue;
+        }
+        c[i] += inc;
+        counted++;
+    }
+    return counted;
+}
+
+static long fill_span(const Fill *F, const Target *T, const SnapTri *t, int j, int i0, int i1)
 {
     double py = (double)j * SUB + HALF, px0 = (double)i0 * SUB + HALF;
     double f_row = F->f0 + F->fx * (px0 - F->x0) + F->fy * (py - F->y0);
@@ -448,6 +478,8 @@ static long fill_span(const Fill *F, const Target *T, int32_t id, int j, int i0,
     float *d = tile_row(T, j, i0);
     int n = i1 - i0 + 1;
     bool persp = T->perspective;
+    if (T->count) return count_span(T, t->count, row, n, (float)f_row, (float)fs, (float)q_row, (float)qs);
+    int32_t id = t->id;
     if (!T->farthest && !T->id && !T->peel && !T->conservative)
         return span_nearest(d, n, (float)f_row, (float)fs, (float)q_row, (float)qs, persp);
     long written = 0;
@@ -463,12 +495,12 @@ static long fill_span(const Fill *F, const Target *T, int32_t id, int j, int i0,
     return written;
 }
 
-static long fill_rect(const Fill *F, const Target *T, int32_t id, int i0, int j0, int i1, int j1)
+static long fill_rect(const Fill *F, const Target *T, const SnapTri *t, int i0, int j0, int i1, int j1)
 {
     long written = 0;
     for (int j = j0; j <= j1; j++) {
         int lo = i0, hi = i1;
-        if (row_span(F, j, &lo, &hi)) written += fill_span(F, T, id, j, lo, hi);
+        if (row_span(F, j, &lo, &hi)) written += fill_span(F, T, t, j, lo, hi);
     }
     return written;
 }
@@ -526,7 +558,8 @@ static void quantise(float *d, size_t n, int bits, double lo, double hi)
     }
 }
 
-static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, const int *bin_start, DepthBuffer *db)
+static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, const int *bin_start, DepthBuffer *db,
+                      long *overflow)
 {
     int tx = tile % s->tiles_x, ty = tile / s->tiles_x;
     int ti0 = tx * TILE, tj0 = ty * TILE;
@@ -534,12 +567,14 @@ static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, cons
     int tj1 = tj0 + TILE - 1 < s->height - 1 ? tj0 + TILE - 1 : s->height - 1;
     const RasterOptions *opt = s->opt;
     float local[TILE * TILE];
+    bool counting = opt->test == RASTER_COUNT_LESS || opt->test == RASTER_COUNT_GREATER;
     Target T = {local, ti0, tj0, db->triangle, opt->peel, s->width, opt->test == RASTER_FARTHEST,
-                s->mode == VALUE_PERSPECTIVE && opt->depth == RASTER_DEPTH_LINEAR, opt->conservative};
+                s->mode == VALUE_PERSPECTIVE && opt->depth == RASTER_DEPTH_LINEAR, opt->conservative,
+                counting ? opt->count : NULL, opt->count_ref, opt->test == RASTER_COUNT_LESS, overflow};
     float empty = T.farthest ? -INFINITY : INFINITY;
-    bool fast = !T.farthest && !T.id && !T.peel && !T.conservative; /* fill_small's case */
+    bool fast = !T.farthest && !T.id && !T.peel && !T.conservative && !counting; /* fill_small's case */
     int n = ti1 - ti0 + 1;
-    for (int i = 0; i < TILE * TILE; i++) local[i] = empty;
+    for (int i = 0; !counting && i < TILE * TILE; i++) local[i] = empty;
     for (int j = tj0; db->triangle && j <= tj1; j++) {
         int32_t *id = db->triangle + (size_t)j * s->width + ti0;
         for (int i = 0; i < n; i++) id[i] = -1;
@@ -553,8 +588,9 @@ static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, cons
         int i0 = t->i0 > ti0 ? t->i0 : ti0, i1 = t->i1 < ti1 ? t->i1 : ti1;
         int j0 = t->j0 > tj0 ? t->j0 : tj0, j1 = t->j1 < tj1 ? t->j1 : tj1;
         if (i0 > i1 || j0 > j1) continue;
-        written += t->small && fast ? fill_small(&F, &T, i0, j0, i1, j1) : fill_rect(&F, &T, t->id, i0, j0, i1, j1);
+        written += t->small && fast ? fill_small(&F, &T, i0, j0, i1, j1) : fill_rect(&F, &T, t, i0, j0, i1, j1);
     }
+    if (counting) return written;
     bool quantised = opt->depth_bits == 16 || opt->depth_bits == 24;
     double lo = opt->depth == RASTER_DEPTH_NDC ? 0.0 : s->view->depth_near;
     double hi = opt->depth == RASTER_DEPTH_NDC ? 1.0 : s->view->depth_far;
@@ -590,7 +626,9 @@ static bool setup_chunk(const Setup *s, const RasterMesh *meshes, int num_meshes
                 const uint32_t *ahead = &ix[3 * (t + PREFETCH_AHEAD - base)];
                 for (int k = 0; k < 3; k++) __builtin_prefetch(&vx[m].v[ahead[k]]);
             }
-            if (!setup_triangle(s, &vx[m], &ix[3 * (t - base)], (int32_t)t, tt)) return false;
+            const int16_t *counts = s->opt->extra ? s->opt->extra[m].counts : NULL;
+            int32_t count = counts ? counts[t - base] : 1;
+            if (!setup_triangle(s, &vx[m], &ix[3 * (t - base)], (int32_t)t, count, tt)) return false;
         }
         base += n;
     }
@@ -598,7 +636,7 @@ static bool setup_chunk(const Setup *s, const RasterMesh *meshes, int num_meshes
 }
 
 /* Passes 3 and 4: bins from the per-thread counts, then the tiles. */
-static long bin_and_fill(const Setup *s, RasterScratch *sc, int nchunks, DepthBuffer *db, bool *ok)
+static long bin_and_fill(const Setup *s, RasterScratch *sc, int nchunks, DepthBuffer *db, bool *ok, long *overflow)
 {
     ThreadTris *tt = sc->chunk;
     int ntiles = s->tiles_x * s->tiles_y;
@@ -630,16 +668,25 @@ static long bin_and_fill(const Setup *s, RasterScratch *sc, int nchunks, DepthBu
                 for (int tx = t->i0 / TILE; tx <= t->i1 / TILE; tx++) bins[cur[ty * s->tiles_x + tx]++] = t;
         }
     }
-    long written = 0;
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : written)
-    for (int tile = 0; tile < ntiles; tile++) written += fill_tile(s, tile, bins, bin_start, db);
+    long written = 0, refused = 0;
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : written, refused)
+    for (int tile = 0; tile < ntiles; tile++) {
+        long tile_refused = 0;
+        written += fill_tile(s, tile, bins, bin_start, db, &tile_refused);
+        refused += tile_refused;
+    }
+    *overflow = refused;
     return written;
 }
 
 static bool check_inputs(const RasterMesh *meshes, int num_meshes, const RasterView *view, const RasterOptions *opt,
                          const DepthBuffer *db, Error *err)
 {
-    if (!db->depth || db->width < 1 || db->height < 1) return error_set(err, "raster: depth buffer not initialised");
+    bool counting = opt->test == RASTER_COUNT_LESS || opt->test == RASTER_COUNT_GREATER;
+    if ((!counting && !db->depth) || db->width < 1 || db->height < 1)
+        return error_set(err, "raster: depth buffer not initialised");
+    if (counting && (!opt->count || !opt->count_ref))
+        return error_set(err, "raster: a counting test needs counters and reference values per texel");
     if (opt->triangle_ids && !db->triangle) return error_set(err, "raster: triangle ids asked for but not allocated");
     if (opt->depth_bits != 0 && opt->depth_bits != 16 && opt->depth_bits != 24)
         return error_set(err, "raster: depth_bits %d is not one of 0 (float32), 16, 24", opt->depth_bits);
@@ -707,7 +754,7 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
     Vertices *cv = calloc((size_t)(num_meshes > 0 ? num_meshes : 1), sizeof *cv);
     bool ok = db->scratch && cv && scratch_prepare(db->scratch, meshes, num_meshes, &s, nchunks, chunk, cv);
     ThreadTris *tt = ok ? db->scratch->chunk : NULL;
-    for (int m = 0; ok && m < num_meshes; m++) transform_vertices(&s, &meshes[m], &cv[m]);
+    for (int m = 0; ok && m < num_meshes; m++) transform_vertices(&s, &meshes[m], opt->extra ? &opt->extra[m] : NULL, &cv[m]);
     if (ok) {
         int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : failed)
@@ -715,7 +762,8 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
                                                               (k + 1) * chunk < total ? (k + 1) * chunk : total, &tt[k]);
         ok = failed == 0;
     }
-    long written = ok ? bin_and_fill(&s, db->scratch, nchunks, db, &ok) : 0;
+    long overflow = 0;
+    long written = ok ? bin_and_fill(&s, db->scratch, nchunks, db, &ok, &overflow) : 0;
     RasterStats st = {total, 0, 0, 0, written};
     for (int k = 0; ok && k < nchunks; k++) {
         st.triangles_culled += tt[k].culled;
@@ -725,5 +773,8 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
     free(cv);
     if (stats) *stats = st;
     if (!ok) return error_set(err, "raster: out of memory (%ld triangles into %dx%d)", total, db->width, db->height);
+    if (overflow)
+        return error_set(err, "raster: %ld counter updates refused: the count would leave int32 [%d, %d]", overflow,
+                         INT32_MIN, INT32_MAX);
     return true;
 }

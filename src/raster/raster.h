@@ -8,7 +8,15 @@
  *
  * Map space: texel (i, j) covers u in [i/W, (i+1)/W], v in [j/H, (j+1)/H]
  * with u = (x_ndc + 1)/2, v = (y_ndc + 1)/2; row j = 0 is v = 0 (y_ndc = -1,
- * the texture convention), and depth is sampled at texel centres. */
+ * the texture convention), and depth is sampled at texel centres.
+ *
+ * Counting (stencil-style, for shadow volumes, course §2.2): instead of
+ * keeping a depth, each fragment whose value is below (or above) the texel's
+ * reference value adds its triangle's signed count to the texel's int32
+ * counter: +count where the triangle is counter-clockwise on the map
+ * (front-facing), -count where it is clockwise. Vertices may be homogeneous
+ * (w = 0: a point at infinity), so volumes extruded to infinity clip exactly
+ * (Everitt & Kilgard 2002). */
 #ifndef SL_RASTER_H
 #define SL_RASTER_H
 #include <stdint.h>
@@ -25,10 +33,24 @@ typedef struct RasterMesh {
     int num_vertices, num_triangles;
 } RasterMesh;
 
+/* What a mesh may add for shadow volumes (RasterOptions.extra). */
+typedef struct RasterMeshExtra {
+    /* Homogeneous weight per vertex, the point (positions[i], weights[i]):
+     * 0 is the point at infinity in direction positions[i]. NULL: all 1. */
+    const float *weights;
+    /* Counting tests: the signed count each triangle adds (NULL: all 1). */
+    const int16_t *counts;
+} RasterMeshExtra;
+
 typedef enum RasterCull { RASTER_CULL_NONE, RASTER_CULL_BACK, RASTER_CULL_FRONT } RasterCull;
 /* Which surface a texel keeps: the nearest (shadow maps) or the farthest
  * (back-face and farthest-layer maps). */
-typedef enum RasterTest { RASTER_NEAREST, RASTER_FARTHEST } RasterTest;
+typedef enum RasterTest {
+    RASTER_NEAREST,
+    RASTER_FARTHEST,
+    RASTER_COUNT_LESS,    /* count fragments whose value < RasterOptions.count_ref[texel] */
+    RASTER_COUNT_GREATER, /* count fragments whose value > count_ref[texel] */
+} RasterTest;
 /* What a texel stores: linear depth (an affine function of the world
  * position, e.g. distance along the light's axis in world units) or the
  * post-projective z_ndc in [0, 1]. */
@@ -59,6 +81,16 @@ typedef struct RasterOptions {
     /* Depth peeling: when non-NULL (same size as the map), fragments at or in
      * front of peel[texel] are discarded, so the map keeps the next layer. */
     const float *peel;
+    /* Counting tests: the reference value per texel (same size and value
+     * space as the map: linear depth or z_ndc), e.g. the view samples' own
+     * depth. Fragments equal to it are not counted. */
+    const float *count_ref;
+    /* Counting tests: per texel, the counter the fragments add to. It is
+     * not cleared: the caller sets the starting counts. An update that would
+     * leave int32 is not made, and the render fails, saying how many. */
+    int32_t *count;
+    /* One per mesh, or NULL: every vertex weight 1, every count 1. */
+    const RasterMeshExtra *extra;
 } RasterOptions;
 
 /* The output: depth per texel (+INFINITY where nothing was drawn with the

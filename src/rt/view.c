@@ -24,6 +24,17 @@ static vec3 frame_dir(const CameraFrame *f, int grid_w, int grid_h, int x, int y
     return v3_normalize_or(d, f->forward);
 }
 
+void camera_axes(const Camera *cam, int grid_w, int grid_h, vec3 *forward, vec3 *right, vec3 *up, float *tan_x,
+                 float *tan_y)
+{
+    CameraFrame f = camera_frame(cam, grid_w, grid_h);
+    *forward = f.forward;
+    *right = f.right;
+    *up = f.up;
+    *tan_x = f.tan_half_y * f.aspect;
+    *tan_y = f.tan_half_y;
+}
+
 void camera_ray(const Camera *cam, int grid_w, int grid_h, int x, int y, vec3 *org, vec3 *dir)
 {
     CameraFrame f = camera_frame(cam, grid_w, grid_h);

@@ -26,6 +26,13 @@ size_t view_samples_bytes(const ViewSamples *vs);
 /* Class of every sample with respect to light `light_index` (see light.h). */
 void view_samples_classify(const ViewSamples *vs, const Scene *scene, int light_index, uint8_t *cls);
 
+/* The camera's frame (world, unit, right-handed: right x up = -forward) and
+ * the grid's image-plane half extents: sample (x, y) looks along forward +
+ * right x_ndc tan_x + up y_ndc tan_y, x_ndc = 2 (x + 1/2) / grid_w - 1,
+ * y_ndc = 1 - 2 (y + 1/2) / grid_h. */
+void camera_axes(const Camera *cam, int grid_w, int grid_h, vec3 *forward, vec3 *right, vec3 *up, float *tan_x,
+                 float *tan_y);
+
 /* World-space ray through sample (x, y) of the grid: origin and unit direction. */
 void camera_ray(const Camera *cam, int grid_w, int grid_h, int x, int y, vec3 *org, vec3 *dir);
 

@@ -41,7 +41,9 @@ static vec3 revolve(float s, float r, float y)
 static vec3 sphere_fn(float s, float t, const float *p)
 {
     float th = PI_F * t; /* t = 0 at the north pole */
-    return revolve(s, p[0] * sinf(th), p[0] * cosf(th));
+    /* sinf(PI_F) is -8.7e-8, not 0: each pole is one point, or the mesh has a hole there */
+    float r = t <= 0.0f || t >= 1.0f ? 0.0f : p[0] * sinf(th);
+    return revolve(s, r, p[0] * cosf(th));
 }
 
 /* Cylinder and cone share one profile: top cap centre, top rim, bottom rim,

@@ -25,6 +25,7 @@ extern const Technique tech_aliasing;
 extern const Technique tech_backprojection;
 extern const Technique tech_light_sampling;
 extern const Technique tech_occlusion_textures;
+extern const Technique tech_shadow_volume;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -46,6 +47,7 @@ static const Technique *const registry[] = {
     &tech_backprojection,
     &tech_light_sampling,
     &tech_occlusion_textures,
+    &tech_shadow_volume,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }

@@ -41,6 +41,7 @@ static const struct { const char *param, *settings; } probes[] = {
     {"depth_bits", "sampling=exhaustive"},
     {"depth_bits", "depth=ndc"}, /* backprojection, occlusion_textures: linear depth's quantisation is absorbed */
     {"stabilize", "projection=perspective"}, /* light_sampling: auto gives its point samples cube maps */
+    {"extrusion", "distance=0.5"}, /* shadow_volume: the default finite length outreaches every shadow */
     {"split_2", "split_1=2"},
     {"split_3", "split_1=2 split_2=3"},
     {"cascade_select", "cascades=8"},
