@@ -198,6 +198,23 @@ function experiment.parse_args(argv, extra)
   return o
 end
 
+-- The set of technique names a script's --techniques option lists
+-- ("all": every one, as {all = true}); an unknown name is a user error
+-- naming the registered ones.
+function experiment.technique_set(text)
+  local set = {}
+  for name in tostring(text):gmatch("[^,%s]+") do
+    if name ~= "all" and not pcall(sl.technique, name) then
+      local known = {}
+      for _, t in ipairs(sl.techniques()) do known[#known + 1] = t.name end
+      error(string.format("--techniques: unknown technique '%s' (registered: all, %s)", name,
+                          table.concat(known, ", ")), 0)
+    end
+    set[name] = true
+  end
+  return set
+end
+
 ---------------------------------------------------------------- configurations
 
 -- Does the technique (a registry description) handle lights of this type?

@@ -42,17 +42,46 @@ local function noise_of(region, field)
   return nil
 end
 
+-- The names report.write accepts: error = "REGION.FIELD" (or FIELD, the
+-- whole image's), time = one of time_order; the metrics are the record's
+-- per-region statistics (src/lab/record.c).
+local region_order = { "all", "umbra", "penumbra", "lit", "terminator" }
+local field_order = { "rmse", "rmse_debiased", "mae", "max_abs", "mean_signed", "leak_mean", "dark_mean",
+                      "misclassified", "noise_rms", "noise_mean" }
+local time_order = { "frame", "evaluate_median", "evaluate_min" }
+
+local function member(list, v)
+  for _, x in ipairs(list) do if x == v then return true end end
+  return false
+end
+
+-- Every error name report.write accepts, for its refusal and the README.
+function report.error_names()
+  local names = {}
+  for _, g in ipairs(region_order) do
+    for _, f in ipairs(field_order) do names[#names + 1] = g .. "." .. f end
+  end
+  return names
+end
+report.time_names = time_order
+
 -- The error metric: a path into the record's metrics, "all.rmse" by default;
--- the getter returns nil for an empty region (json.null), so it is not plotted.
+-- the getter returns nil for an empty region (json.null), so it is not
+-- plotted. An unknown region or field is refused with the valid names.
 local function metric_getter(path)
-  local region, field = path:match("^(%w+)%.([%w_]+)$")
+  local region, field = tostring(path):match("^(%w+)%.([%w_]+)$")
   if not region then region, field = "all", path end
+  if not (member(region_order, region) and member(field_order, field)) then
+    error(string.format("report.write: unknown error metric '%s'; valid: REGION.FIELD with REGION one of %s and " ..
+                        "FIELD one of %s (e.g. penumbra.rmse; a bare FIELD means all.FIELD); the rows are recorded: rerun with --resume", tostring(path),
+                        table.concat(region_order, ", "), table.concat(field_order, ", ")), 3)
+  end
   local label = (field_names[field] or field) .. (region == "all" and "" or " (" .. region .. ")")
   return function(r)
     local m = r.record.metrics[region]
     local v = m and m[field]
     return type(v) == "number" and v or nil
-  end, label, noise_of(region, field)
+  end, label, noise_of(region, field), region .. "." .. field
 end
 
 -- The dashed line of a plot of rows: the largest noise among them of the
@@ -250,8 +279,10 @@ function report.write(result, opts)
     return nil
   end
   local ctx = { dir = result.out .. "/plots", time = opts.time or "frame" }
-  if not time_fields[ctx.time] then error("report: time must be frame, evaluate_median or evaluate_min", 2) end
-  ctx.err, ctx.err_label, ctx.noise = metric_getter(opts.error or "all.rmse")
+  if not time_fields[ctx.time] then
+    error(string.format("report.write: unknown time '%s'; valid: %s", tostring(ctx.time), table.concat(time_order, ", ")), 2)
+  end
+  ctx.err, ctx.err_label, ctx.noise, ctx.err_path = metric_getter(opts.error or "all.rmse")
   local rows = ok_rows(result.rows)
   local axes = swept_names(rows)
   mark_swept(rows, axes)
@@ -277,7 +308,7 @@ function report.write(result, opts)
   end
   local index = result.out .. "/index.html"
   html.write_index(index, { result = result, rows = result.rows, ok_rows = rows, plots = plots, opts = opts,
-                            err_label = ctx.err_label, time_label = time_fields[ctx.time], time = ctx.time,
+                            err_label = ctx.err_label, err_path = ctx.err_path, time_label = time_fields[ctx.time], time = ctx.time,
                             err = ctx.err, noise = ctx.noise })
   io.stderr:write("report: " .. index .. "\n")
   return index
