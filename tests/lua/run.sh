@@ -5,7 +5,7 @@
 # same sweep as 2 shards through GNU Parallel (and the Slurm script) merged
 # and compared with the unsharded run, merge refusals, the shipped
 # experiments at tiny sizes (error-vs-time's plots show every registered
-# technique), and the report opened in headless Chromium.
+# technique; each lab's questions cite what its index.html shows), and the report opened in headless Chromium.
 # Usage: tests/lua/run.sh build/shadowlab.
 # Prints "lua: N passed, N failed".
 set -u
@@ -216,10 +216,20 @@ TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeat 1 --warm
 expect error_vs_time_runs 0 "report:" -- "$SL" run experiments/error-vs-time.lua --factors 1 $TINY --out "$TMP/evt"
 expect error_vs_time_plot_shows_every_registered_technique 0 "every registered technique" -- \
     "$SL" run tests/lua/every-technique.lua "$TMP/evt"
+# the labs with images (their questions cite the signed-error images), then every question's citations
+LAB_TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeat 1 --warmup 0"
 expect lab_kernel_size_runs 0 "0 failed" "report:" -- \
-    "$SL" run experiments/lab-kernel-size.lua --techniques pcf $TINY --out "$TMP/lks"
-expect lab_light_radius_runs_a_shard 0 "0 failed" -- \
-    "$SL" run experiments/lab-light-radius.lua $TINY --shard 0/24 --out "$TMP/llr"
+    "$SL" run experiments/lab-kernel-size.lua $LAB_TINY --out "$TMP/lks"
+expect lab_kernel_size_questions_answerable_from_its_report 0 "5 questions answerable" -- \
+    "$SL" run tests/lua/lab-questions.lua lab-kernel-size "$TMP/lks"
+expect lab_light_radius_runs 0 "0 failed" "report:" -- \
+    "$SL" run experiments/lab-light-radius.lua --techniques hard,pcf $LAB_TINY --out "$TMP/llr"
+expect lab_light_radius_questions_answerable_from_its_report 0 "5 questions answerable" -- \
+    "$SL" run tests/lua/lab-questions.lua lab-light-radius "$TMP/llr"
+expect lab_light_radius_refuses_an_unknown_technique 1 "unknown technique 'pfc'" "registered: all," -- \
+    "$SL" run experiments/lab-light-radius.lua --techniques pfc $LAB_TINY --out "$TMP/llr-bad"
+expect report_refuses_an_unknown_metric 1 "unknown error metric 'penumbra_rmse'" "penumbra.rmse" "terminator" -- \
+    "$SL" run tests/lua/bad/unknown-metric.lua --out "$TMP/bad-metric"
 expect defaults_matrix_has_no_unexpected_umbra_leak 0 "0 unexpected umbra leaks above 0.10, 0 failed" -- "$SL" run experiments/defaults-matrix.lua --scenes sphere-on-plane.lua,contact.lua --set camera.width=48 --set camera.height=36 --samples 16 --out "$TMP/dm"
 
 # ---- the report in headless Chromium: every image and plot loads, nothing logged
