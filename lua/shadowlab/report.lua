@@ -9,6 +9,7 @@ local json = require "shadowlab.json"
 local pareto = require "shadowlab.pareto"
 local plot = require "shadowlab.plot"
 local html = require "shadowlab.html"
+local sl = package.loaded.shadowlab or require "shadowlab"
 
 local report = {}
 
@@ -203,11 +204,31 @@ end
 
 ---------------------------------------------------------------- plots
 
+-- A row's time in ms with the spread of its timed evaluations: the frame
+-- time's evaluation part is the median, so its bar runs from the frame time
+-- with the fastest evaluation to that with the slowest (frame = builds +
+-- set-up + median evaluation, docs/architecture.md). Records without
+-- evaluate_max (older builds) get no bar.
+local function time_spread(rec, field)
+  local t = rec.timings_s
+  local v = t[field]
+  if type(v) ~= "number" then return nil end
+  local lo, hi = v, v
+  if type(t.evaluate_max) == "number" and type(t.evaluate_min) == "number" then
+    local base = field == "evaluate_min" and t.evaluate_min or t.evaluate_median
+    lo, hi = v - base + t.evaluate_min, v - base + t.evaluate_max
+  end
+  return 1e3 * v, 1e3 * lo, 1e3 * hi
+end
+
+local spread_note = "bars: fastest to slowest of the timed evaluations"
+
 local function error_vs_time(ctx, variant_rows, name)
   local points, by_tech = {}, {}
   local techs = {}
   for _, r in ipairs(variant_rows) do
-    local p = { x = 1e3 * r.record.timings_s[ctx.time], y = ctx.err(r), row = r }
+    local x, lo, hi = time_spread(r.record, ctx.time)
+    local p = { x = x, lo = lo, hi = hi, y = ctx.err(r), row = r }
     if type(p.y) == "number" and type(p.x) == "number" and p.x > 0 then
       points[#points + 1] = p
       if not by_tech[r.technique] then
@@ -223,46 +244,98 @@ local function error_vs_time(ctx, variant_rows, name)
   local series = {}
   for _, t in ipairs(techs) do
     local pts = {}
-    for _, p in ipairs(by_tech[t]) do pts[#pts + 1] = { p.x, p.y } end
-    series[#series + 1] = { title = t, points = pts, style = "points" }
+    for _, p in ipairs(by_tech[t]) do pts[#pts + 1] = { p.x, p.y, math.max(p.lo, 1e-9), p.hi } end
+    series[#series + 1] = { title = t, points = pts, style = "points", bars = "x" }
   end
-  local fpts = {}
-  for _, p in ipairs(front) do fpts[#fpts + 1] = { p.x, p.y } end
+  local fpts, labels = {}, {}
+  for _, p in ipairs(front) do
+    fpts[#fpts + 1] = { p.x, p.y }
+    labels[#labels + 1] = { p.x, p.y, p.row.label }
+  end
   series[#series + 1] = { title = "Pareto front", points = fpts, style = "front" }
+  series[#series + 1] = { title = "Pareto labels", points = labels, style = "labels" }
   local noise = noise_line(ctx, variant_rows)
   return plot.draw(ctx.dir, "error-vs-time-" .. name, {
     title = ctx.err_label .. " against " .. time_fields[ctx.time],
-    rows = variant_rows, subtitle = noise and "dashed: reference " .. ctx.noise.label or nil, noise = ctx.noise,
+    rows = variant_rows, noise = ctx.noise,
+    subtitle = (noise and "dashed: reference " .. ctx.noise.label .. "; " or "") .. spread_note ..
+               "\nPareto front circled, its points labelled with their configuration",
     xlabel = time_fields[ctx.time] .. " (ms, log scale)", ylabel = ctx.err_label, logx = true,
     series = series, hline = noise,
   })
 end
 
+local function family_of(technique)
+  local ok, desc = pcall(sl.technique, technique)
+  return ok and desc.family or "other"
+end
+
+-- The largest value over the smallest positive one among the series' y.
+local function y_span(series)
+  local lo, hi = math.huge, 0
+  for _, s in ipairs(series) do
+    for _, p in ipairs(s.points) do
+      if p[2] > 0 then lo, hi = math.min(lo, p[2]), math.max(hi, p[2]) end
+    end
+  end
+  return hi > 0 and hi / lo or 1
+end
+
+-- Error (what = "error") or a time (what = a time_fields name) against a
+-- swept axis, one series per configuration that differs only along it;
+-- times with their spread as bars and a log scale once they span a decade.
+-- Returns the plots drawn: the whole, and when one family's times dwarf
+-- another's (a span over 20x across families) one plot per family too.
 local function along_axis(ctx, axis, scene_rows, name, what)
   local series = {}
   for _, s in ipairs(series_along(axis, scene_rows)) do
     local pts = {}
     for _, r in ipairs(s.rows) do
-      local y -- nil for an empty region: the point is left out
-      if what == "error" then y = ctx.err(r) else y = 1e3 * r.record.timings_s[ctx.time] end
-      if type(y) == "number" then pts[#pts + 1] = { x_value(axis, r), y } end
+      if what == "error" then
+        local y = ctx.err(r) -- nil for an empty region: the point is left out
+        if type(y) == "number" then pts[#pts + 1] = { x_value(axis, r), y } end
+      else
+        local y, lo, hi = time_spread(r.record, what)
+        if y then pts[#pts + 1] = { x_value(axis, r), y, lo, hi } end
+      end
     end
-    if #pts > 0 then series[#series + 1] = { title = s.label, points = pts, style = "linespoints" } end
+    if #pts > 0 then
+      series[#series + 1] = { title = s.label, points = pts, style = "linespoints", bars = what ~= "error" and "y" or nil,
+                              family = family_of(s.rows[1].technique), technique = s.rows[1].technique }
+    end
   end
-  if #series == 0 then return nil end
+  if #series == 0 then return {} end
   local lo, hi = math.huge, -math.huge
   for _, s in ipairs(series) do
     for _, p in ipairs(s.points) do lo, hi = math.min(lo, p[1]), math.max(hi, p[1]) end
   end
   local logx = lo > 0 and hi / lo >= 8
-  local ylabel = what == "error" and ctx.err_label or time_fields[ctx.time] .. " (ms)"
+  local label = what == "error" and ctx.err_label or time_fields[what]
   local noise = what == "error" and noise_line(ctx, scene_rows) or nil
-  return plot.draw(ctx.dir, (what == "error" and "error-vs-" or "cost-vs-") .. slug(axis.name) .. "-" .. name, {
-    title = (what == "error" and ctx.err_label or time_fields[ctx.time]) .. " against " .. axis.name,
-    rows = scene_rows, xlabel = axis.name .. (logx and " (log scale)" or ""), ylabel = ylabel,
-    logx = logx, series = series, hline = noise, noise = what == "error" and ctx.noise or nil,
-    subtitle = noise and "dashed: reference " .. ctx.noise.label or nil,
-  })
+  local stem = (what == "error" and "error-vs-" or what == "frame" and "cost-vs-" or "eval-vs-") .. slug(axis.name)
+  local function draw(list, suffix, title_extra)
+    local logy = what ~= "error" and y_span(list) >= 10
+    local notes = {}
+    if noise then notes[#notes + 1] = "dashed: reference " .. ctx.noise.label end
+    if what ~= "error" then notes[#notes + 1] = spread_note end
+    return plot.draw(ctx.dir, stem .. "-" .. name .. suffix, {
+      title = label .. " against " .. axis.name .. title_extra,
+      rows = scene_rows, xlabel = axis.name .. (logx and " (log scale)" or ""),
+      ylabel = what == "error" and label or label .. (logy and " (ms, log scale)" or " (ms)"),
+      logx = logx, logy = logy, series = list, hline = noise, noise = what == "error" and ctx.noise or nil,
+      subtitle = #notes > 0 and table.concat(notes, "; ") or nil,
+    })
+  end
+  local files = { draw(series, "", "") }
+  if what ~= "error" then
+    -- by family; within one family, by technique (csm's seconds beside pcf's milliseconds)
+    local groups, order = group_by(series, function(s) return s.family end)
+    if #order == 1 then groups, order = group_by(series, function(s) return s.technique end) end
+    if #order > 1 and y_span(series) > 20 then
+      for _, g in ipairs(order) do files[#files + 1] = draw(groups[g], "-" .. slug(g), " (" .. g .. " only)") end
+    end
+  end
+  return files
 end
 
 ---------------------------------------------------------------- entry point
@@ -300,9 +373,13 @@ function report.write(result, opts)
   for _, f in ipairs(scene_order) do
     local scene_name = slug(by_scene[f][1].variant.scene)
     for _, axis in ipairs(axes) do
-      for _, what in ipairs({ "error", "cost" }) do
-        local file = along_axis(ctx, axis, by_scene[f], scene_name, what)
-        if file then plots.axes[#plots.axes + 1] = { axis = axis, what = what, file = file } end
+      -- the error, the time plotted against it, and the evaluation alone (the frame time hides it)
+      local whats = { "error", ctx.time }
+      if ctx.time == "frame" then whats[3] = "evaluate_median" end
+      for _, what in ipairs(whats) do
+        for _, file in ipairs(along_axis(ctx, axis, by_scene[f], scene_name, what)) do
+          plots.axes[#plots.axes + 1] = { axis = axis, what = what, file = file }
+        end
       end
     end
   end
