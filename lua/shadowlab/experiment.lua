@@ -24,11 +24,15 @@ Experiment.__index = Experiment
 -- but each of csm's term counts holds GiB of moments that no other uses).
 -- It changes what is rebuilt, not the results: frame time counts a
 -- resource's build time whether this run built or reused it.
+-- error_scale: the signed error at full colour in every configuration's
+-- error image (estimate - reference, visibility units), one scale for the
+-- whole sweep so its images compare (0: each image its own, rounded up
+-- from its largest |error|).
 local defaults = { samples = 256, pattern = "r2", seed = 1, light = 1, repeats = 3, warmup = 1, images = true,
-                   exr = false, time_budget_s = 1, resource_budget_gib = 2 }
+                   exr = false, time_budget_s = 1, resource_budget_gib = 2, error_scale = 0.5 }
 local spec_fields = { name = true, scenes = true, overrides = true, samples = true, pattern = true, seed = true,
                       light = true, repeats = true, warmup = true, images = true, exr = true, cache = true,
-                      description = true, time_budget_s = true, resource_budget_gib = true }
+                      description = true, time_budget_s = true, resource_budget_gib = true, error_scale = true }
 
 local function merged(a, b)
   local m = {}
@@ -60,6 +64,10 @@ function experiment.new(spec)
   local self = setmetatable({ name = spec.name, description = spec.description, variants = {}, entries = {} },
                             Experiment)
   for k, v in pairs(defaults) do self[k] = spec[k] == nil and v or spec[k] end
+  if type(self.error_scale) ~= "number" or not (self.error_scale >= 0 and self.error_scale <= 1e6) then
+    error("experiment.new: error_scale must be a number in [0, 1e6] (0: each error image its own scale), got " ..
+          tostring(self.error_scale), 2)
+  end
   self.cache, self.overrides = spec.cache, spec.overrides or {}
   for _, s in ipairs(spec.scenes or {}) do
     if type(s) == "table" then self:scene(s[1], s[2]) else self:scene(s) end
@@ -261,7 +269,7 @@ end
 function Experiment:settings()
   return { samples = self.samples, pattern = self.pattern, seed = self.seed, light = self.light,
            repeats = self.repeats, warmup = self.warmup, time_budget_s = self.time_budget_s, measure = "visibility",
-           overrides = self.overrides }
+           error_scale = self.error_scale, overrides = self.overrides }
 end
 
 -- The CSV columns: the standard ones, then every parameter of the
@@ -335,7 +343,8 @@ end
 function Experiment:compare_options(config, out_dir)
   return { technique = config.entry.technique.name, params = config.entry.params, light = self.light,
            repeats = self.repeats, warmup = self.warmup, samples = self.samples, pattern = self.pattern,
-           seed = self.seed, cache = self.cache, out = out_dir, exr = self.exr, time_budget = self.time_budget_s }
+           seed = self.seed, cache = self.cache, out = out_dir, exr = self.exr, time_budget = self.time_budget_s,
+           error_scale = self.error_scale }
 end
 
 -- The reference's images for a variant, once per results folder.
@@ -345,6 +354,28 @@ function Experiment:reference_images(config, out)
   config.variant.lab:reference{ light = self.light, samples = self.samples, pattern = self.pattern,
                                 seed = self.seed, cache = self.cache, exr = false,
                                 out = out .. "/" .. paths.reference:match("^(.*)/") }
+end
+
+-- The machine's load when a row was measured: the 1-minute load average
+-- (/proc/loadavg) and the online CPU cores (/proc/cpuinfo); nil where they
+-- cannot be read. A load above the cores means other processes shared
+-- them while this row was timed.
+local cores_online
+local function machine_load()
+  local f = io.open("/proc/loadavg", "r")
+  if not f then return nil end
+  local avg1 = tonumber((f:read("l") or ""):match("^(%S+)"))
+  f:close()
+  if not cores_online then
+    local c = io.open("/proc/cpuinfo", "r")
+    if c then
+      cores_online = 0
+      for line in c:lines() do if line:match("^processor%s*:") then cores_online = cores_online + 1 end end
+      c:close()
+    end
+  end
+  if not avg1 or not cores_online or cores_online == 0 then return nil end
+  return { loadavg_1min = avg1, cores = cores_online }
 end
 
 function Experiment:run_one(config, o, header)
@@ -359,6 +390,7 @@ function Experiment:run_one(config, o, header)
     if paths then self:reference_images(config, o.out) end
     return r
   end)
+  row.load = machine_load()
   if ok then
     row.status, row.record = "ok", run:record()
     if paths then row.images = paths; row.images.dir = nil end

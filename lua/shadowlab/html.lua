@@ -19,12 +19,15 @@ body { font: 14px/1.45 sans-serif; margin: 1.5em auto; max-width: 1200px; paddin
 h1 { font-size: 1.6em; } h2 { margin-top: 2em; border-bottom: 1px solid #ccc; } h3 { margin-bottom: .3em; }
 table { border-collapse: collapse; font-size: 12px; } td, th { border: 1px solid #ddd; padding: 2px 6px; }
 th { background: #f3f3f3; } td.n { text-align: right; font-variant-numeric: tabular-nums; }
-tr.front td { background: #eef7ee; } tr.err td { background: #fbeaea; } td.unres { color: #a33; }
+tr.front td { background: #eef7ee; } tr.err td { background: #fbeaea; } .unres { color: #a33; }
 details { font-size: 11px; color: #555; } summary { cursor: pointer; }
 .plots { display: grid; grid-template-columns: repeat(auto-fill, minmax(480px, 1fr)); gap: 8px; }
 .plots img { width: 100%; border: 1px solid #eee; }
 .grid { display: grid; grid-template-columns: repeat(3, minmax(0, 1fr)); gap: 10px; }
 .grid figure { margin: 0; font-size: 11px; } .grid img { width: 100%; image-rendering: pixelated; }
+.key { display: flex; gap: 8px; align-items: center; font-size: 12px; margin: .5em 0; }
+.key .bar { display: inline-block; width: 240px; height: 14px; border: 1px solid #999;
+            background: linear-gradient(to right, rgb(0,0,255), rgb(255,255,255), rgb(255,0,0)); }
 .ref { outline: 3px solid #444; } #load-status { font-weight: bold; } .note { color: #555; }
 ]]
 
@@ -100,6 +103,29 @@ local function plotted_region(doc)
   return nil
 end
 
+-- Was the machine loaded beyond its cores when the row was timed?
+local function overloaded(r)
+  return type(r.load) == "table" and type(r.load.loadavg_1min) == "number" and type(r.load.cores) == "number" and
+         r.load.loadavg_1min > r.load.cores
+end
+
+-- The report's note on rows timed under load (nil when none was).
+local function load_note(doc)
+  local n, top, cores = 0, 0, nil
+  for _, r in ipairs(doc.ok_rows) do
+    if overloaded(r) then
+      n, cores = n + 1, r.load.cores
+      top = math.max(top, r.load.loadavg_1min)
+    end
+  end
+  if n == 0 then return nil end
+  return string.format('<p class="note load"><b>Load:</b> %d of %d rows were timed while the machine\'s 1-minute ' ..
+                       "load average exceeded its %d cores (up to %.2f; marked \"loaded\" in the table): other " ..
+                       "processes shared the cores, so their times are longer and coarser than on an idle machine " ..
+                       "(evaluation medians have been seen quantised in 4 ms steps under load).</p>", n,
+                       #doc.ok_rows, cores, top)
+end
+
 local function results_table(doc, out)
   -- the reference noise of the error shown (its region and statistic), else the whole image's rms
   local noise = doc.noise or { label = "noise rms", value = function(rec) return rec.metrics.all.noise_rms end }
@@ -132,7 +158,10 @@ local function results_table(doc, out)
         '<td class="n">%s</td><td class="n">%s</td><td>%s</td><td>%s</td>' ..
         '<td>%s<details><summary>all %d</summary>%s</details></td>',
         num(m.all.misclassified, "%.4f"), num(noise.value(rec), "%.5f"),
-        type(pen) == "table" and num(pen.count, "%d") or "", num(1e3 * t[doc.time], "%.3f"),
+        type(pen) == "table" and num(pen.count, "%d") or "",
+        num(1e3 * t[doc.time], "%.3f") .. (overloaded(r) and
+          string.format(' <span class="unres" title="load average %.2f on %d cores">loaded</span>',
+                        r.load.loadavg_1min, r.load.cores) or ""),
         num(1e3 * t.evaluate_median, "%.3f"), num(1e3 * t.evaluate_min, "%.3f"), num(1e3 * t.technique_build, "%.3f"),
         esc(rec.resource_cache), esc(rec.reference.origin), #changed > 0 and esc(params_text(r.params, changed)) or "defaults",
         #all, esc(params_text(r.params, all)))
@@ -151,6 +180,35 @@ end
 local function figure(src, caption, class)
   return string.format('<figure><img src="%s" alt="%s"%s><figcaption>%s</figcaption></figure>', esc(src),
                        esc(caption), class and ' class="' .. class .. '"' or "", caption)
+end
+
+-- The signed-error images' scales (the record's error_png_scale), sorted.
+local function error_scales(rows)
+  local set, list = {}, {}
+  for _, r in ipairs(rows) do
+    local v = r.images and r.record.metrics.error_png_scale
+    if type(v) == "number" and not set[v] then set[v], list[#list + 1] = true, v end
+  end
+  table.sort(list)
+  return list
+end
+
+-- The colour bar of the error images, the same ramp report.c's
+-- error_colors writes: blue at -scale (too dark), white at 0, red at
+-- +scale (leaking), clamped beyond; grey: not a lit candidate.
+local function error_key(doc, out)
+  local scales = error_scales(doc.ok_rows)
+  if #scales == 0 then return end
+  if #scales > 1 then
+    out[#out + 1] = '<p class="note">The error images do not share one scale (±' .. table.concat(scales, ", ±") ..
+                    "; rows from runs with another error_scale): compare them by their captions.</p>"
+    return
+  end
+  local s = scales[1]
+  out[#out + 1] = string.format('<div class="key"><span>-%g (too dark)</span><span class="bar" title="signed error: ' ..
+                                'estimate - reference"></span><span>+%g (leaking)</span> <span class="note">signed ' ..
+                                "error of every image below, one scale for the whole report; clamped beyond ±%g; " ..
+                                "grey: not a lit sample</span></div>", s, s, s)
 end
 
 -- The images of one scene variant: the reference first (shaded and
@@ -234,6 +292,7 @@ function html.write_index(path, doc)
   out[#out + 1] = '<p>Data: <a href="results.csv">results.csv</a> · <a href="records.jsonl">records.jsonl</a> ' ..
                   "(one JSON record per configuration, with every parameter, timing and resource).</p>"
   out[#out + 1] = definitions
+  out[#out + 1] = load_note(doc)
   questions_block(doc.opts, out)
   out[#out + 1] = "<h2>" .. esc(doc.err_label) .. " against " .. esc(doc.time_label) .. "</h2><div class=\"plots\">"
   for _, p in ipairs(doc.plots.time) do plot_block(p.file, out) end
@@ -246,6 +305,7 @@ function html.write_index(path, doc)
   out[#out + 1] = "<h2>Results</h2><p class=\"note\">Green rows are on the Pareto front of their scene.</p>"
   results_table(doc, out)
   out[#out + 1] = "<h2>Images beside the reference</h2>"
+  error_key(doc, out)
   for _, p in ipairs(doc.plots.time) do
     local v = p.variant
     out[#out + 1] = "<h3>" .. esc(v.scene .. (v.label ~= "" and " [" .. v.label .. "]" or "")) .. "</h3>"

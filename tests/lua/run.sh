@@ -113,6 +113,18 @@ if grep -q "reference 16 samples, noise rms" "$FULL/plots/error-vs-time-sphere-o
     ok plot_states_scene_resolution_samples_noise
 else no plot_states_scene_resolution_samples_noise "title"; fi
 
+# ---- the report's timing spread, load note and one error scale
+if "$SL" run tests/lua/report-checks.lua "$FULL" >"$TMP/err" 2>&1; then ok report_timing_spread_and_one_error_scale
+else no report_timing_spread_and_one_error_scale "$(head -1 "$TMP/err")"; fi
+for load in 99 0; do
+    rm -rf "$TMP/load" && cp -r "$FULL" "$TMP/load"
+    sed -i "s/\"loadavg_1min\":[0-9.]*/\"loadavg_1min\":$load/" "$TMP/load/records.jsonl"
+    "$SL" run "$SWEEP" --out "$TMP/load" --resume --quiet >/dev/null 2>&1
+    note=$(grep -c 'Load:</b> 6 of 6 rows' "$TMP/load/index.html")
+    want=$([ "$load" = 99 ] && echo 1 || echo 0)
+    [ "$note" -eq "$want" ] && ok "report_load_note_at_load_$load" || no "report_load_note_at_load_$load" "$note notes"
+done
+
 # ---- --fresh with other reference samples shows the new reference, not the old one under a new caption
 "$SL" run "$SWEEP" --out "$TMP/refs" --samples 4 --quiet >/dev/null 2>&1
 grep -o 'images/ref-[0-9a-f]*/reference.png' "$TMP/refs/index.html" | sort -u >"$TMP/refs-before"
