@@ -272,6 +272,11 @@ local function questions_block(opts, out)
     out[#out + 1] = "</ol>"
   end
   for _, n in ipairs(opts.notes or {}) do out[#out + 1] = '<p class="note"><b>Note:</b> ' .. esc(n) .. "</p>" end
+  -- a script's own sections ({title, html}: html it wrote, escaped by it), before the plots
+  for _, sec in ipairs(opts.sections or {}) do
+    out[#out + 1] = "<h2>" .. esc(sec.title) .. "</h2>"
+    out[#out + 1] = sec.html
+  end
 end
 
 function html.write_index(path, doc)

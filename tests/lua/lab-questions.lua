@@ -29,6 +29,16 @@ local cites = {
     { header("umbra RMSE"), header("penumbra RMSE"), header("lit RMSE"), signed_errors },
     { header("noise rms"), noise_line, unresolved },
   },
+  ["lab-aliasing"] = {
+    { header("misclassified"), header("false shadow"), header("false lit"),
+      { what = "the signed-error images against the truth", text = "signed error against the truth" },
+      { what = "the colour bar", text = '<div class="key">' } },
+    { plot("aliasing-depth"), header("e_x (across)"), header("e_y (along the view)") },
+    { header("m_s max"), header("m_t max"), header("m_s max x m_t max") },
+    { header("undersampled (m &gt; 1)"), { what = "the m maps' colour key", text = "Key of the m maps" },
+      header("storage factor") },
+    { header("fitted z (ends near)"), header("camera z_f") },
+  },
   ["lab-kernel-size"] = {
     { plot("error-vs-K"), header("penumbra RMSE") },
     { cold_warm, frame_def },

@@ -238,6 +238,14 @@ expect lab_light_radius_runs 0 "0 failed" "report:" -- \
     "$SL" run experiments/lab-light-radius.lua --techniques hard,pcf $LAB_TINY --out "$TMP/llr"
 expect lab_light_radius_questions_answerable_from_its_report 0 "5 questions answerable" -- \
     "$SL" run tests/lua/lab-questions.lua lab-light-radius "$TMP/llr"
+expect lab_aliasing_runs 0 "0 failed" "report:" -- \
+    "$SL" run experiments/lab-aliasing.lua $LAB_TINY --out "$TMP/lal"
+expect lab_aliasing_questions_answerable_from_its_report 0 "5 questions answerable" -- \
+    "$SL" run tests/lua/lab-questions.lua lab-aliasing "$TMP/lal"
+expect lab_aliasing_sweeps_a_scene_knob 0 "0 failed" "report:" -- \
+    "$SL" run experiments/lab-aliasing.lua $LAB_TINY --sweep gamma:60,120 --out "$TMP/lal-gamma"
+expect lab_aliasing_refuses_a_bad_sweep 1 "--sweep expects KNOB:V1,V2" -- \
+    "$SL" run experiments/lab-aliasing.lua $LAB_TINY --sweep frob:1,2 --out "$TMP/lal-bad"
 expect lab_light_radius_refuses_an_unknown_technique 1 "unknown technique 'pfc'" "registered: all," -- \
     "$SL" run experiments/lab-light-radius.lua --techniques pfc $LAB_TINY --out "$TMP/llr-bad"
 expect report_refuses_an_unknown_metric 1 "unknown error metric 'penumbra_rmse'" "penumbra.rmse" "terminator" -- \
