@@ -11,6 +11,7 @@
 local sl = package.loaded.shadowlab or require "shadowlab"
 local json = require "shadowlab.json"
 local records = require "shadowlab.records"
+local inspector = require "shadowlab.inspector"
 
 local experiment = {}
 local Experiment = {}
@@ -387,7 +388,10 @@ function Experiment:run_one(config, o, header)
   local paths = o.images and self:image_paths(config) or nil
   local ok, run = pcall(function()
     local r = config.variant.lab:compare(self:compare_options(config, paths and o.out .. "/" .. paths.dir))
-    if paths then self:reference_images(config, o.out) end
+    if paths then
+      self:reference_images(config, o.out)
+      inspector.write(r, o.out .. "/" .. paths.dir, config.key) -- the report's pixel inspector
+    end
     return r
   end)
   row.load = machine_load()

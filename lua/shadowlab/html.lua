@@ -5,6 +5,7 @@
 -- (the browser test reads that line).
 local sl = package.loaded.shadowlab or require "shadowlab"
 local records = require "shadowlab.records"
+local inspector = require "shadowlab.inspector"
 
 local html = {}
 
@@ -177,9 +178,17 @@ local function plot_block(p, out)
                                 esc(p.svg), esc(p.svg), esc(p.png), esc(p.svg))
 end
 
-local function figure(src, caption, class)
+-- A figure; `inspect` (a row) makes its image open the pixel inspector on
+-- that configuration (inspector.lua).
+local function figure(src, caption, class, inspect)
+  local attrs = class and ' class="' .. class .. '"' or ""
+  if inspect then
+    attrs = attrs .. string.format(' data-inspect="%s" data-ref="%s" data-est="%s" data-err="%s" data-label="%s"',
+                                   esc(inspect.key), esc(inspect.images.reference), esc(inspect.images.visibility),
+                                   esc(inspect.images.error), esc(inspect.label))
+  end
   return string.format('<figure><img src="%s" alt="%s"%s><figcaption>%s</figcaption></figure>', esc(src),
-                       esc(caption), class and ' class="' .. class .. '"' or "", caption)
+                       esc(caption), attrs, caption)
 end
 
 -- The signed-error images' scales (the record's error_png_scale), sorted.
@@ -223,14 +232,15 @@ local function image_grid(entry, doc, out)
   out[#out + 1] = figure(first.images.reference, "reference visibility (" ..
                          esc(first.record.reference.samples) .. " samples)", "ref")
   out[#out + 1] = '<p class="note">Each configuration below: shaded, visibility, signed error (estimate - ' ..
-                  "reference; blue too dark, red leaking).</p>"
+                  "reference; blue too dark, red leaking). Click one to inspect its pixels: reference, estimate " ..
+                  "and signed error at single-pixel zoom, the values under the cursor.</p>"
   for _, r in ipairs(entry.rows) do
     if r.images then -- rows resumed from a run with --no-images have none
       local cap = esc(r.label) .. ": " .. esc(doc.err_label) .. " " .. num(doc.err(r), "%.4f")
-      out[#out + 1] = figure(r.images.shaded, esc(r.label) .. ": shaded")
-      out[#out + 1] = figure(r.images.visibility, cap)
+      out[#out + 1] = figure(r.images.shaded, esc(r.label) .. ": shaded", nil, r)
+      out[#out + 1] = figure(r.images.visibility, cap, nil, r)
       out[#out + 1] = figure(r.images.error, esc(r.label) .. ": signed error, ±" ..
-                             num(r.record.metrics.error_png_scale, "%g") .. " (blue too dark, red leaking)")
+                             num(r.record.metrics.error_png_scale, "%g") .. " (blue too dark, red leaking)", nil, r)
     end
   end
   out[#out + 1] = "</div>"
@@ -316,6 +326,7 @@ function html.write_index(path, doc)
     out[#out + 1] = "<h3>" .. esc(v.scene .. (v.label ~= "" and " [" .. v.label .. "]" or "")) .. "</h3>"
     image_grid(p, doc, out)
   end
+  out[#out + 1] = inspector.html
   out[#out + 1] = check_script
   out[#out + 1] = "</body></html>"
   sl.write_file(path, table.concat(out, "\n") .. "\n")

@@ -253,11 +253,11 @@ expect report_refuses_an_unknown_metric 1 "unknown error metric 'penumbra_rmse'"
 expect defaults_matrix_has_no_unexpected_umbra_leak 0 "0 unexpected umbra leaks above 0.10, 0 failed" -- "$SL" run experiments/defaults-matrix.lua --scenes sphere-on-plane.lua,contact.lua --set camera.width=48 --set camera.height=36 --samples 16 --out "$TMP/dm"
 
 # ---- the report in headless Chromium: every image and plot loads, nothing logged
-browse() { # browse DIR: DOM after load in $TMP/dom.html, browser log in $TMP/browser.log
+browse() { # browse DIR [HASH]: DOM after load in $TMP/dom.html, browser log in $TMP/browser.log
     rm -rf "$TMP/profile"
     timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-background-networking \
         --disable-component-update --disable-sync --no-first-run --user-data-dir="$TMP/profile" \
-        --enable-logging=stderr --v=0 --virtual-time-budget=10000 --dump-dom "file://$1/index.html" \
+        --enable-logging=stderr --v=0 --virtual-time-budget=10000 --dump-dom "file://$1/index.html${2:+#$2}" \
         >"$TMP/dom.html" 2>"$TMP/browser.log"
 }
 if command -v chromium >/dev/null; then
@@ -268,6 +268,12 @@ if command -v chromium >/dev/null; then
     else no browser_loads_every_image "$(grep -o 'id="load-status"[^<]*' "$TMP/dom.html")"; fi
     if grep -q "CONSOLE" "$TMP/browser.log"; then no browser_page_logs_nothing "$(grep CONSOLE "$TMP/browser.log" | head -2)"
     else ok browser_page_logs_nothing; fi
+    # the pixel inspector: click the first configuration, flip twice with f, read a penumbra pixel
+    xy=$("$SL" run tests/lua/inspector-check.lua pick "$FULL" 2>"$TMP/err")
+    browse "$FULL" "inspect-test=$xy"
+    if "$SL" run tests/lua/inspector-check.lua check "$FULL" "$TMP/dom.html" >"$TMP/err" 2>&1; then
+        ok browser_pixel_inspector_reads_the_engines_values
+    else no browser_pixel_inspector_reads_the_engines_values "$(head -1 "$TMP/err")"; fi
     cp -r "$FULL" "$TMP/broken" && rm "$TMP/broken/plots/cost-vs-offset-scale-sphere-on-plane.svg"
     browse "$TMP/broken"
     if grep -q 'data-missing="1"' "$TMP/dom.html"; then ok browser_check_sees_a_missing_plot
