@@ -310,6 +310,7 @@ function html.write_index(path, doc)
   out[#out + 1] = load_note(doc)
   questions_block(doc.opts, out)
   out[#out + 1] = "<h2>" .. esc(doc.err_label) .. " against " .. esc(doc.time_label) .. "</h2><div class=\"plots\">"
+  plot_block(doc.plots.combined, out)
   for _, p in ipairs(doc.plots.time) do plot_block(p.file, out) end
   out[#out + 1] = "</div>"
   if #doc.plots.axes > 0 then

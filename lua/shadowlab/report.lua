@@ -223,43 +223,51 @@ end
 
 local spread_note = "bars: fastest to slowest of the timed evaluations"
 
-local function error_vs_time(ctx, variant_rows, name)
-  local points, by_tech = {}, {}
-  local techs = {}
-  for _, r in ipairs(variant_rows) do
+local function variant_text(v) return v.scene .. (v.label ~= "" and " [" .. v.label .. "]" or "") end
+
+-- Error against time, one series per technique. For one scene variant
+-- (combined = false) with its Pareto front, marked on the rows and its
+-- points labelled; combined, the rows of every variant, a series per
+-- technique and variant, without a front (fronts compare one scene).
+local function error_vs_time(ctx, rows, name, combined)
+  local points, by_series, order = {}, {}, {}
+  for _, r in ipairs(rows) do
     local x, lo, hi = time_spread(r.record, ctx.time)
     local p = { x = x, lo = lo, hi = hi, y = ctx.err(r), row = r }
     if type(p.y) == "number" and type(p.x) == "number" and p.x > 0 then
       points[#points + 1] = p
-      if not by_tech[r.technique] then
-        by_tech[r.technique] = {}
-        techs[#techs + 1] = r.technique
+      local key = combined and r.technique .. " " .. variant_text(r.variant) or r.technique
+      if not by_series[key] then
+        by_series[key] = {}
+        order[#order + 1] = key
       end
-      table.insert(by_tech[r.technique], p)
+      table.insert(by_series[key], p)
     end
   end
   if #points == 0 then return nil end
-  local front = pareto.front(points)
-  for _, p in ipairs(front) do p.row.on_front = true end
   local series = {}
-  for _, t in ipairs(techs) do
+  for _, t in ipairs(order) do
     local pts = {}
-    for _, p in ipairs(by_tech[t]) do pts[#pts + 1] = { p.x, p.y, math.max(p.lo, 1e-9), p.hi } end
+    for _, p in ipairs(by_series[t]) do pts[#pts + 1] = { p.x, p.y, math.max(p.lo, 1e-9), p.hi } end
     series[#series + 1] = { title = t, points = pts, style = "points", bars = "x" }
   end
-  local fpts, labels = {}, {}
-  for _, p in ipairs(front) do
-    fpts[#fpts + 1] = { p.x, p.y }
-    labels[#labels + 1] = { p.x, p.y, p.row.label }
+  if not combined then
+    local front = pareto.front(points)
+    local fpts, labels = {}, {}
+    for _, p in ipairs(front) do
+      p.row.on_front = true
+      fpts[#fpts + 1] = { p.x, p.y }
+      labels[#labels + 1] = { p.x, p.y, p.row.label }
+    end
+    series[#series + 1] = { title = "Pareto front", points = fpts, style = "front" }
+    series[#series + 1] = { title = "Pareto labels", points = labels, style = "labels" }
   end
-  series[#series + 1] = { title = "Pareto front", points = fpts, style = "front" }
-  series[#series + 1] = { title = "Pareto labels", points = labels, style = "labels" }
-  local noise = noise_line(ctx, variant_rows)
+  local noise = noise_line(ctx, rows)
   return plot.draw(ctx.dir, "error-vs-time-" .. name, {
-    title = ctx.err_label .. " against " .. time_fields[ctx.time],
-    rows = variant_rows, noise = ctx.noise,
+    title = ctx.err_label .. " against " .. time_fields[ctx.time] .. (combined and ", every scene variant" or ""),
+    rows = rows, noise = ctx.noise,
     subtitle = (noise and "dashed: reference " .. ctx.noise.label .. "; " or "") .. spread_note ..
-               "\nPareto front circled, its points labelled with their configuration",
+               (combined and "" or "\nPareto front circled, its points labelled with their configuration"),
     xlabel = time_fields[ctx.time] .. " (ms, log scale)", ylabel = ctx.err_label, logx = true,
     series = series, hline = noise,
   })
@@ -369,6 +377,7 @@ function report.write(result, opts)
     names_used[name] = true
     plots.time[#plots.time + 1] = { variant = v, file = error_vs_time(ctx, by_variant[h], name), rows = by_variant[h] }
   end
+  if #variant_order > 1 then plots.combined = error_vs_time(ctx, rows, "all-variants", true) end
   local by_scene, scene_order = group_by(rows, function(r) return r.variant.file end)
   for _, f in ipairs(scene_order) do
     local scene_name = slug(by_scene[f][1].variant.scene)

@@ -100,7 +100,7 @@ done
 expect sweep_refuses_to_overwrite 1 "--resume" -- "$SL" run "$SWEEP" --out "$FULL" --quiet
 expect sweep_resume_of_a_finished_run_computes_nothing 0 "0 computed, 6 already recorded" -- \
     "$SL" run "$SWEEP" --out "$FULL" --resume
-for f in index.html plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg \
+for f in index.html plots/error-vs-time-all-variants.svg plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg \
          plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.png plots/error-vs-offset-scale-sphere-on-plane.svg \
          plots/cost-vs-lights-1-radius-sphere-on-plane.png; do
     [ -s "$FULL/$f" ] && ok "report_wrote_$(basename "$f")" || no "report_wrote_$(basename "$f")" "missing"
