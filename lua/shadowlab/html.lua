@@ -74,7 +74,10 @@ local function non_default_keys(r)
   end
   local keys = {}
   for _, k in ipairs(sorted_keys(r.params)) do
-    if default[k] == nil or tostring(default[k]) ~= tostring(r.params[k]) then keys[#keys + 1] = k end
+    local d, v = default[k], r.params[k]
+    local same
+    if type(d) == "number" and type(v) == "number" then same = d == v else same = tostring(d) == tostring(v) end
+    if d == nil or not same then keys[#keys + 1] = k end
   end
   return keys
 end

@@ -32,7 +32,7 @@ local function data_text(series)
   return table.concat(blocks, "\n\n\n") .. "\n"
 end
 
--- Distinct colours (Kelly's and Tableau's, told apart on white) and
+-- Distinct colours (Tableau's ten, then ten more told apart on white) and
 -- markers (gnuplot's 15 point types on the cairo and SVG terminals).
 local colours = { "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
                   "#7f7f7f", "#bcbd22", "#000080", "#008080", "#800000", "#808000", "#ff00ff", "#00c000",

@@ -56,16 +56,6 @@ local function member(list, v)
   return false
 end
 
--- Every error name report.write accepts, for its refusal and the README.
-function report.error_names()
-  local names = {}
-  for _, g in ipairs(region_order) do
-    for _, f in ipairs(field_order) do names[#names + 1] = g .. "." .. f end
-  end
-  return names
-end
-report.time_names = time_order
-
 -- The error metric: a path into the record's metrics, "all.rmse" by default;
 -- the getter returns nil for an empty region (json.null), so it is not
 -- plotted. An unknown region or field is refused with the valid names.
@@ -74,8 +64,9 @@ local function metric_getter(path)
   if not region then region, field = "all", path end
   if not (member(region_order, region) and member(field_order, field)) then
     error(string.format("report.write: unknown error metric '%s'; valid: REGION.FIELD with REGION one of %s and " ..
-                        "FIELD one of %s (e.g. penumbra.rmse; a bare FIELD means all.FIELD); the rows are recorded: rerun with --resume", tostring(path),
-                        table.concat(region_order, ", "), table.concat(field_order, ", ")), 3)
+                        "FIELD one of %s (e.g. penumbra.rmse; a bare FIELD means all.FIELD); the rows are " ..
+                        "recorded: rerun with --resume", tostring(path), table.concat(region_order, ", "),
+                        table.concat(field_order, ", ")), 3)
   end
   local label = (field_names[field] or field) .. (region == "all" and "" or " (" .. region .. ")")
   return function(r)
