@@ -1,45 +1,48 @@
 -- lab-kernel-size.lua -- a teaching lab: the filter kernel of percentage-closer
 -- filtering (course §4.1.2, Eq. 4.1) against the ray-traced reference, for a
--- small and a large spherical light. It sweeps the kernel width K of every
--- registered technique that has a parameter K (pcf, the filtered maps, and
--- whatever lands later; --techniques pcf,vsm for some), all else at its
--- defaults, and keeps `sm` (no filtering) as the baseline. Run:
--- build/shadowlab run experiments/lab-kernel-size.lua, then open
--- reports/lab-kernel-size/index.html.
---
--- Questions for students (answer from the report's plots, table and images):
---  1. For the small light (radius 0.1), which K gives the lowest penumbra
---     RMSE? For the large light (0.4)? Why does the best K grow with the
---     light, and why is a fixed K wrong for both at once?
---  2. The shadow map is built once for both light sizes: it is rendered
---     from the light's centre, so its key ignores the radius. Find in
---     records.jsonl that only a technique's first configuration builds it
---     and every other K, on either radius, reuses it ("action": "reused").
---     Why does the frame time still count its build time (see the definition
---     in the report)? What does it tell you about how much PCF knows of the
---     light's size?
---  3. How does the cost grow with K for the box kernel (cost-vs-K plot)?
---     Explain the shape from the number of depth comparisons per pixel.
---  4. Look at the signed-error images for the largest K: where does PCF leak
---     light (red) and where does it over-darken (blue)? Why near the contact
---     of the ball's shadow with the ground less than at its outer edge?
---  5. Which configurations are on the Pareto front? Is the unfiltered shadow
---     map ever on it, and why?
+-- small and a large spherical light. It sweeps pcf's kernel width K, all else
+-- at its defaults, and keeps `sm` (no filtering) as the baseline; other
+-- techniques with a parameter K on request (--techniques pcf,vsm, or all).
+-- The ball rests on the ground here (the scene's ball floats 0.4 above it),
+-- so its shadow has a contact point. Run:
+--   build/shadowlab run experiments/lab-kernel-size.lua [--techniques pcf,vsm]
+-- then open reports/lab-kernel-size/index.html, which starts with the
+-- questions below; the plots, the results table and the images answer them.
 local sl = require "shadowlab"
 local sweep = require "shadowlab.sweep"
 local experiment = require "shadowlab.experiment"
 local report = require "shadowlab.report"
 
+local QUESTIONS = {
+  "For the small light (radius 0.1), which K gives the lowest penumbra RMSE (the error-vs-K plot, the table's " ..
+  "penumbra RMSE column)? For the large light (0.4)? Why does the best K grow with the light, and why is a " ..
+  "fixed K wrong for both at once?",
+  "The shadow map is rendered from the light's centre, so its key ignores K: in the table's resources column " ..
+  "only the first K of each light size is \"cold\" (it built the map) and every other K is \"warm\" (it reused " ..
+  "it). Why does the frame time still count the map's build time (see the definition of frame time above)? " ..
+  "What does it tell you about how much PCF knows of the light's size? (Run with --techniques csm and every " ..
+  "row is cold: csm's moment map and summed-area table, 3.3 GiB at map_size 1024, exceed the experiment's " ..
+  "2 GiB resource budget, so they are dropped and rebuilt for every K.)",
+  "How does the cost grow with K for the box kernel (the cost-vs-K plot, log scales)? Explain the shape from " ..
+  "the number of depth comparisons per pixel.",
+  "Look at the signed-error images for the largest K: where does PCF leak light (red) and where does it " ..
+  "over-darken (blue)? Is its error larger near the point where the ball touches the ground or at the " ..
+  "shadow's outer edge? Explain from the true penumbra's width, which grows with the distance from the ball " ..
+  "to the ground, against PCF's kernel, whose width in texels is the same everywhere.",
+  "Which configurations are on the Pareto front (the error-vs-time plot's labelled points, the table's green " ..
+  "rows)? Is the unfiltered shadow map (sm) ever on it, and why?",
+}
+
 local KERNELS = { 1, 3, 5, 9, 15, 25 }
-local args = experiment.parse_args(arg, { techniques = { default = "all",
-  help = "comma-separated techniques to sweep (all: every one with a parameter K)" } })
-local chosen = {}
-for name in args.extra.techniques:gmatch("[^,]+") do chosen[name] = true end
+local args = experiment.parse_args(arg, { techniques = { default = "pcf",
+  help = "comma-separated techniques with a parameter K to sweep (all: every one)" } })
+local chosen = experiment.technique_set(args.extra.techniques)
 
 local exp = experiment.new{
   name = "lab-kernel-size", samples = 256, repeats = 3, warmup = 1,
-  overrides = { ["camera.width"] = 320, ["camera.height"] = 240 },
-  description = "PCF kernel width K against the reference, for a small and a large spherical light.",
+  overrides = { ["camera.width"] = 320, ["camera.height"] = 240, ["objects[2].translate"] = { 0, 0.6, 0 } },
+  description = "PCF kernel width K against the reference, for a small and a large spherical light, " ..
+                "the ball resting on the ground.",
 }
 exp:scene("scenes/sphere-on-plane.lua", sweep.grid{ ["lights[1].radius"] = { 0.1, 0.4 } })
 
@@ -60,4 +63,4 @@ if with_k == 0 then
   error("lab-kernel-size: no chosen technique has a parameter K (pcf should: see `shadowlab list`)", 0)
 end
 if pcall(sl.technique, "sm") then exp:add("sm") end
-report.write(exp:run(args), { title = "Lab: PCF kernel size", error = "penumbra.rmse" })
+report.write(exp:run(args), { title = "Lab: PCF kernel size", error = "penumbra.rmse", questions = QUESTIONS })

@@ -11,6 +11,7 @@
 local sl = package.loaded.shadowlab or require "shadowlab"
 local json = require "shadowlab.json"
 local records = require "shadowlab.records"
+local inspector = require "shadowlab.inspector"
 
 local experiment = {}
 local Experiment = {}
@@ -24,11 +25,15 @@ Experiment.__index = Experiment
 -- but each of csm's term counts holds GiB of moments that no other uses).
 -- It changes what is rebuilt, not the results: frame time counts a
 -- resource's build time whether this run built or reused it.
+-- error_scale: the signed error at full colour in every configuration's
+-- error image (estimate - reference, visibility units), one scale for the
+-- whole sweep so its images compare (0: each image its own, rounded up
+-- from its largest |error|).
 local defaults = { samples = 256, pattern = "r2", seed = 1, light = 1, repeats = 3, warmup = 1, images = true,
-                   exr = false, time_budget_s = 1, resource_budget_gib = 2 }
+                   exr = false, time_budget_s = 1, resource_budget_gib = 2, error_scale = 0.5 }
 local spec_fields = { name = true, scenes = true, overrides = true, samples = true, pattern = true, seed = true,
                       light = true, repeats = true, warmup = true, images = true, exr = true, cache = true,
-                      description = true, time_budget_s = true, resource_budget_gib = true }
+                      description = true, time_budget_s = true, resource_budget_gib = true, error_scale = true }
 
 local function merged(a, b)
   local m = {}
@@ -60,6 +65,10 @@ function experiment.new(spec)
   local self = setmetatable({ name = spec.name, description = spec.description, variants = {}, entries = {} },
                             Experiment)
   for k, v in pairs(defaults) do self[k] = spec[k] == nil and v or spec[k] end
+  if type(self.error_scale) ~= "number" or not (self.error_scale >= 0 and self.error_scale <= 1e6) then
+    error("experiment.new: error_scale must be a number in [0, 1e6] (0: each error image its own scale), got " ..
+          tostring(self.error_scale), 2)
+  end
   self.cache, self.overrides = spec.cache, spec.overrides or {}
   for _, s in ipairs(spec.scenes or {}) do
     if type(s) == "table" then self:scene(s[1], s[2]) else self:scene(s) end
@@ -198,6 +207,23 @@ function experiment.parse_args(argv, extra)
   return o
 end
 
+-- The set of technique names a script's --techniques option lists
+-- ("all": every one, as {all = true}); an unknown name is a user error
+-- naming the registered ones.
+function experiment.technique_set(text)
+  local set = {}
+  for name in tostring(text):gmatch("[^,%s]+") do
+    if name ~= "all" and not pcall(sl.technique, name) then
+      local known = {}
+      for _, t in ipairs(sl.techniques()) do known[#known + 1] = t.name end
+      error(string.format("--techniques: unknown technique '%s' (registered: all, %s)", name,
+                          table.concat(known, ", ")), 0)
+    end
+    set[name] = true
+  end
+  return set
+end
+
 ---------------------------------------------------------------- configurations
 
 -- Does the technique (a registry description) handle lights of this type?
@@ -244,7 +270,7 @@ end
 function Experiment:settings()
   return { samples = self.samples, pattern = self.pattern, seed = self.seed, light = self.light,
            repeats = self.repeats, warmup = self.warmup, time_budget_s = self.time_budget_s, measure = "visibility",
-           overrides = self.overrides }
+           error_scale = self.error_scale, overrides = self.overrides }
 end
 
 -- The CSV columns: the standard ones, then every parameter of the
@@ -318,7 +344,8 @@ end
 function Experiment:compare_options(config, out_dir)
   return { technique = config.entry.technique.name, params = config.entry.params, light = self.light,
            repeats = self.repeats, warmup = self.warmup, samples = self.samples, pattern = self.pattern,
-           seed = self.seed, cache = self.cache, out = out_dir, exr = self.exr, time_budget = self.time_budget_s }
+           seed = self.seed, cache = self.cache, out = out_dir, exr = self.exr, time_budget = self.time_budget_s,
+           error_scale = self.error_scale }
 end
 
 -- The reference's images for a variant, once per results folder.
@@ -330,6 +357,28 @@ function Experiment:reference_images(config, out)
                                 out = out .. "/" .. paths.reference:match("^(.*)/") }
 end
 
+-- The machine's load when a row was measured: the 1-minute load average
+-- (/proc/loadavg) and the online CPU cores (/proc/cpuinfo); nil where they
+-- cannot be read. A load above the cores means other processes shared
+-- them while this row was timed.
+local cores_online
+local function machine_load()
+  local f = io.open("/proc/loadavg", "r")
+  if not f then return nil end
+  local avg1 = tonumber((f:read("l") or ""):match("^(%S+)"))
+  f:close()
+  if not cores_online then
+    local c = io.open("/proc/cpuinfo", "r")
+    if c then
+      cores_online = 0
+      for line in c:lines() do if line:match("^processor%s*:") then cores_online = cores_online + 1 end end
+      c:close()
+    end
+  end
+  if not avg1 or not cores_online or cores_online == 0 then return nil end
+  return { loadavg_1min = avg1, cores = cores_online }
+end
+
 function Experiment:run_one(config, o, header)
   local row = { index = config.index, key = config.key, label = config.label, experiment = header.fingerprint,
                 lua_helpers = records.helpers_hash(),
@@ -339,9 +388,13 @@ function Experiment:run_one(config, o, header)
   local paths = o.images and self:image_paths(config) or nil
   local ok, run = pcall(function()
     local r = config.variant.lab:compare(self:compare_options(config, paths and o.out .. "/" .. paths.dir))
-    if paths then self:reference_images(config, o.out) end
+    if paths then
+      self:reference_images(config, o.out)
+      inspector.write(r, o.out .. "/" .. paths.dir, config.key) -- the report's pixel inspector
+    end
     return r
   end)
+  row.load = machine_load()
   if ok then
     row.status, row.record = "ok", run:record()
     if paths then row.images = paths; row.images.dir = nil end

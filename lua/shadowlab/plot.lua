@@ -2,7 +2,11 @@
 -- per series), the script (NAME.gp, kept so a figure can be restyled and
 -- redrawn by hand), and the two images. Series styles: "points",
 -- "linespoints", "lines" (analytic curves), "front" (a Pareto staircase,
--- black); `hline` draws a dashed horizontal line (the reference's noise,
+-- black), "labels" (each point's third value written beside it); a series
+-- with `bars = "x"` or `"y"` draws each point's {x, y, low, high} as an
+-- error bar along that axis. Within one plot every series has its own
+-- colour (20) and its own marker (15), the pair unique beyond that.
+-- `hline` draws a dashed horizontal line (the reference's noise,
 -- `noise` = {label, value(record)} naming it in the subtitle);
 -- `logx`, `logy` log scales. The subtitle's first part (scene, resolution,
 -- reference samples and noise) is built from the records plotted; the
@@ -18,16 +22,22 @@ local function data_text(series)
   local blocks = {}
   for i, s in ipairs(series) do
     local lines = { "# " .. s.title }
-    for _, p in ipairs(s.points) do lines[#lines + 1] = string.format("%.9g %.9g", p[1], p[2]) end
+    for _, p in ipairs(s.points) do
+      if s.style == "labels" then lines[#lines + 1] = string.format("%.9g %.9g %s", p[1], p[2], quoted(p[3]))
+      elseif s.bars then lines[#lines + 1] = string.format("%.9g %.9g %.9g %.9g", p[1], p[2], p[3], p[4])
+      else lines[#lines + 1] = string.format("%.9g %.9g", p[1], p[2]) end
+    end
     blocks[i] = table.concat(lines, "\n")
   end
   return table.concat(blocks, "\n\n\n") .. "\n"
 end
 
--- Distinct colour and marker pairs for many series (12 colours x 13 markers).
+-- Distinct colours (Tableau's ten, then ten more told apart on white) and
+-- markers (gnuplot's 15 point types on the cairo and SVG terminals).
 local colours = { "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
-                  "#7f7f7f", "#bcbd22", "#000080", "#008080" }
-local markers = { 5, 7, 9, 11, 13, 4, 6, 8, 10, 12, 1, 2, 3 }
+                  "#7f7f7f", "#bcbd22", "#000080", "#008080", "#800000", "#808000", "#ff00ff", "#00c000",
+                  "#4b0082", "#ff6060", "#a0522d", "#40e0d0" }
+local markers = { 5, 7, 9, 11, 13, 15, 4, 6, 8, 10, 12, 14, 1, 2, 3 }
 
 local function look(i)
   return string.format('pt %d lc rgb "%s"', markers[(i - 1) % #markers + 1], colours[(i - 1) % #colours + 1])
@@ -39,6 +49,13 @@ local function plot_clause(data, i, s)
     return string.format('%s index %d using 1:2 with steps lw 2 lc rgb "black" title %s, ' ..
                          '%s index %d using 1:2 with points pt 6 ps 2.4 lc rgb "black" notitle',
                          quoted(data), i - 1, quoted(s.title), quoted(data), i - 1)
+  elseif s.style == "labels" then
+    return string.format('%s index %d using 1:2:3 with labels left offset 0.8,0.6 font ",8" tc rgb "black" notitle',
+                         quoted(data), i - 1)
+  elseif s.bars then
+    local joined = s.style == "linespoints" and "lines" or "bars"
+    style = string.format("using 1:2:3:4 with %serror%s ps 1.1 lw 1.2 %s", s.bars, joined, look(i))
+    return string.format("%s index %d %s title %s", quoted(data), i - 1, style, quoted(s.title))
   elseif s.style == "linespoints" then style = "with linespoints ps 1.1 lw 1.5 " .. look(i)
   elseif s.style == "lines" then style = "with lines lw 2 " .. look(i)
   else style = "with points ps 1.3 " .. look(i) end
@@ -124,7 +141,7 @@ local function script_text(name, spec)
   }
   local ymax = spec.hline or 0
   for _, s in ipairs(spec.series) do
-    for _, p in ipairs(s.points) do ymax = math.max(ymax, p[2]) end
+    for _, p in ipairs(s.points) do ymax = math.max(ymax, s.bars == "y" and p[4] or p[2]) end
   end
   if spec.logy then lines[#lines + 1] = "set logscale y"
   else lines[#lines + 1] = ymax > 0 and string.format("set yrange [0:%.9g]", 1.08 * ymax) or "set yrange [0:*]" end

@@ -278,7 +278,7 @@ end
 ---------------------------------------------------------------- comparing
 
 -- A row without what differs between two runs of the same configuration:
--- timings, resource build/reuse, cache states, machine, output paths. Two
+-- timings, resource build/reuse, cache states, machine and its load, output paths. Two
 -- runs agree when their comparable rows encode to the same JSON.
 local run_specific = {
   record = { timings_s = true, resources = true, technique_resources = true, resource_cache = true,
@@ -289,6 +289,7 @@ local run_specific = {
 function records.comparable(row)
   local copy = {}
   for k, v in pairs(row) do copy[k] = v end
+  copy.load = nil -- the machine's load average when the row ran (experiment.lua)
   if row.record then
     local rec = {}
     for k, v in pairs(row.record) do

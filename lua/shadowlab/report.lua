@@ -9,6 +9,7 @@ local json = require "shadowlab.json"
 local pareto = require "shadowlab.pareto"
 local plot = require "shadowlab.plot"
 local html = require "shadowlab.html"
+local sl = package.loaded.shadowlab or require "shadowlab"
 
 local report = {}
 
@@ -42,17 +43,37 @@ local function noise_of(region, field)
   return nil
 end
 
+-- The names report.write accepts: error = "REGION.FIELD" (or FIELD, the
+-- whole image's), time = one of time_order; the metrics are the record's
+-- per-region statistics (src/lab/record.c).
+local region_order = { "all", "umbra", "penumbra", "lit", "terminator" }
+local field_order = { "rmse", "rmse_debiased", "mae", "max_abs", "mean_signed", "leak_mean", "dark_mean",
+                      "misclassified", "noise_rms", "noise_mean" }
+local time_order = { "frame", "evaluate_median", "evaluate_min" }
+
+local function member(list, v)
+  for _, x in ipairs(list) do if x == v then return true end end
+  return false
+end
+
 -- The error metric: a path into the record's metrics, "all.rmse" by default;
--- the getter returns nil for an empty region (json.null), so it is not plotted.
+-- the getter returns nil for an empty region (json.null), so it is not
+-- plotted. An unknown region or field is refused with the valid names.
 local function metric_getter(path)
-  local region, field = path:match("^(%w+)%.([%w_]+)$")
+  local region, field = tostring(path):match("^(%w+)%.([%w_]+)$")
   if not region then region, field = "all", path end
+  if not (member(region_order, region) and member(field_order, field)) then
+    error(string.format("report.write: unknown error metric '%s'; valid: REGION.FIELD with REGION one of %s and " ..
+                        "FIELD one of %s (e.g. penumbra.rmse; a bare FIELD means all.FIELD); the rows are " ..
+                        "recorded: rerun with --resume", tostring(path), table.concat(region_order, ", "),
+                        table.concat(field_order, ", ")), 3)
+  end
   local label = (field_names[field] or field) .. (region == "all" and "" or " (" .. region .. ")")
   return function(r)
     local m = r.record.metrics[region]
     local v = m and m[field]
     return type(v) == "number" and v or nil
-  end, label, noise_of(region, field)
+  end, label, noise_of(region, field), region .. "." .. field
 end
 
 -- The dashed line of a plot of rows: the largest noise among them of the
@@ -174,66 +195,146 @@ end
 
 ---------------------------------------------------------------- plots
 
-local function error_vs_time(ctx, variant_rows, name)
-  local points, by_tech = {}, {}
-  local techs = {}
-  for _, r in ipairs(variant_rows) do
-    local p = { x = 1e3 * r.record.timings_s[ctx.time], y = ctx.err(r), row = r }
+-- A row's time in ms with the spread of its timed evaluations: the frame
+-- time's evaluation part is the median, so its bar runs from the frame time
+-- with the fastest evaluation to that with the slowest (frame = builds +
+-- set-up + median evaluation, docs/architecture.md). Records without
+-- evaluate_max (older builds) get no bar.
+local function time_spread(rec, field)
+  local t = rec.timings_s
+  local v = t[field]
+  if type(v) ~= "number" then return nil end
+  local lo, hi = v, v
+  if type(t.evaluate_max) == "number" and type(t.evaluate_min) == "number" then
+    local base = field == "evaluate_min" and t.evaluate_min or t.evaluate_median
+    lo, hi = v - base + t.evaluate_min, v - base + t.evaluate_max
+  end
+  return 1e3 * v, 1e3 * lo, 1e3 * hi
+end
+
+local spread_note = "bars: fastest to slowest of the timed evaluations"
+
+local function variant_text(v) return v.scene .. (v.label ~= "" and " [" .. v.label .. "]" or "") end
+
+-- Error against time, one series per technique. For one scene variant
+-- (combined = false) with its Pareto front, marked on the rows and its
+-- points labelled; combined, the rows of every variant, a series per
+-- technique and variant, without a front (fronts compare one scene).
+local function error_vs_time(ctx, rows, name, combined)
+  local points, by_series, order = {}, {}, {}
+  for _, r in ipairs(rows) do
+    local x, lo, hi = time_spread(r.record, ctx.time)
+    local p = { x = x, lo = lo, hi = hi, y = ctx.err(r), row = r }
     if type(p.y) == "number" and type(p.x) == "number" and p.x > 0 then
       points[#points + 1] = p
-      if not by_tech[r.technique] then
-        by_tech[r.technique] = {}
-        techs[#techs + 1] = r.technique
+      local key = combined and r.technique .. " " .. variant_text(r.variant) or r.technique
+      if not by_series[key] then
+        by_series[key] = {}
+        order[#order + 1] = key
       end
-      table.insert(by_tech[r.technique], p)
+      table.insert(by_series[key], p)
     end
   end
   if #points == 0 then return nil end
-  local front = pareto.front(points)
-  for _, p in ipairs(front) do p.row.on_front = true end
   local series = {}
-  for _, t in ipairs(techs) do
+  for _, t in ipairs(order) do
     local pts = {}
-    for _, p in ipairs(by_tech[t]) do pts[#pts + 1] = { p.x, p.y } end
-    series[#series + 1] = { title = t, points = pts, style = "points" }
+    for _, p in ipairs(by_series[t]) do pts[#pts + 1] = { p.x, p.y, math.max(p.lo, 1e-9), p.hi } end
+    series[#series + 1] = { title = t, points = pts, style = "points", bars = "x" }
   end
-  local fpts = {}
-  for _, p in ipairs(front) do fpts[#fpts + 1] = { p.x, p.y } end
-  series[#series + 1] = { title = "Pareto front", points = fpts, style = "front" }
-  local noise = noise_line(ctx, variant_rows)
+  if not combined then
+    local front = pareto.front(points)
+    local fpts, labels = {}, {}
+    for _, p in ipairs(front) do
+      p.row.on_front = true
+      fpts[#fpts + 1] = { p.x, p.y }
+      labels[#labels + 1] = { p.x, p.y, p.row.label }
+    end
+    series[#series + 1] = { title = "Pareto front", points = fpts, style = "front" }
+    series[#series + 1] = { title = "Pareto labels", points = labels, style = "labels" }
+  end
+  local noise = noise_line(ctx, rows)
   return plot.draw(ctx.dir, "error-vs-time-" .. name, {
-    title = ctx.err_label .. " against " .. time_fields[ctx.time],
-    rows = variant_rows, subtitle = noise and "dashed: reference " .. ctx.noise.label or nil, noise = ctx.noise,
+    title = ctx.err_label .. " against " .. time_fields[ctx.time] .. (combined and ", every scene variant" or ""),
+    rows = rows, noise = ctx.noise,
+    subtitle = (noise and "dashed: reference " .. ctx.noise.label .. "; " or "") .. spread_note ..
+               (combined and "" or "\nPareto front circled, its points labelled with their configuration"),
     xlabel = time_fields[ctx.time] .. " (ms, log scale)", ylabel = ctx.err_label, logx = true,
     series = series, hline = noise,
   })
 end
 
+local function family_of(technique)
+  local ok, desc = pcall(sl.technique, technique)
+  return ok and desc.family or "other"
+end
+
+-- The largest value over the smallest positive one among the series' y.
+local function y_span(series)
+  local lo, hi = math.huge, 0
+  for _, s in ipairs(series) do
+    for _, p in ipairs(s.points) do
+      if p[2] > 0 then lo, hi = math.min(lo, p[2]), math.max(hi, p[2]) end
+    end
+  end
+  return hi > 0 and hi / lo or 1
+end
+
+-- Error (what = "error") or a time (what = a time_fields name) against a
+-- swept axis, one series per configuration that differs only along it;
+-- times with their spread as bars and a log scale once they span a decade.
+-- Returns the plots drawn: the whole, and when one family's times dwarf
+-- another's (a span over 20x across families) one plot per family too.
 local function along_axis(ctx, axis, scene_rows, name, what)
   local series = {}
   for _, s in ipairs(series_along(axis, scene_rows)) do
     local pts = {}
     for _, r in ipairs(s.rows) do
-      local y -- nil for an empty region: the point is left out
-      if what == "error" then y = ctx.err(r) else y = 1e3 * r.record.timings_s[ctx.time] end
-      if type(y) == "number" then pts[#pts + 1] = { x_value(axis, r), y } end
+      if what == "error" then
+        local y = ctx.err(r) -- nil for an empty region: the point is left out
+        if type(y) == "number" then pts[#pts + 1] = { x_value(axis, r), y } end
+      else
+        local y, lo, hi = time_spread(r.record, what)
+        if y then pts[#pts + 1] = { x_value(axis, r), y, lo, hi } end
+      end
     end
-    if #pts > 0 then series[#series + 1] = { title = s.label, points = pts, style = "linespoints" } end
+    if #pts > 0 then
+      series[#series + 1] = { title = s.label, points = pts, style = "linespoints", bars = what ~= "error" and "y" or nil,
+                              family = family_of(s.rows[1].technique), technique = s.rows[1].technique }
+    end
   end
-  if #series == 0 then return nil end
+  if #series == 0 then return {} end
   local lo, hi = math.huge, -math.huge
   for _, s in ipairs(series) do
     for _, p in ipairs(s.points) do lo, hi = math.min(lo, p[1]), math.max(hi, p[1]) end
   end
   local logx = lo > 0 and hi / lo >= 8
-  local ylabel = what == "error" and ctx.err_label or time_fields[ctx.time] .. " (ms)"
+  local label = what == "error" and ctx.err_label or time_fields[what]
   local noise = what == "error" and noise_line(ctx, scene_rows) or nil
-  return plot.draw(ctx.dir, (what == "error" and "error-vs-" or "cost-vs-") .. slug(axis.name) .. "-" .. name, {
-    title = (what == "error" and ctx.err_label or time_fields[ctx.time]) .. " against " .. axis.name,
-    rows = scene_rows, xlabel = axis.name .. (logx and " (log scale)" or ""), ylabel = ylabel,
-    logx = logx, series = series, hline = noise, noise = what == "error" and ctx.noise or nil,
-    subtitle = noise and "dashed: reference " .. ctx.noise.label or nil,
-  })
+  local stem = (what == "error" and "error-vs-" or what == "frame" and "cost-vs-" or "eval-vs-") .. slug(axis.name)
+  local function draw(list, suffix, title_extra)
+    local logy = what ~= "error" and y_span(list) >= 10
+    local notes = {}
+    if noise then notes[#notes + 1] = "dashed: reference " .. ctx.noise.label end
+    if what ~= "error" then notes[#notes + 1] = spread_note end
+    return plot.draw(ctx.dir, stem .. "-" .. name .. suffix, {
+      title = label .. " against " .. axis.name .. title_extra,
+      rows = scene_rows, xlabel = axis.name .. (logx and " (log scale)" or ""),
+      ylabel = what == "error" and label or label .. (logy and " (ms, log scale)" or " (ms)"),
+      logx = logx, logy = logy, series = list, hline = noise, noise = what == "error" and ctx.noise or nil,
+      subtitle = #notes > 0 and table.concat(notes, "; ") or nil,
+    })
+  end
+  local files = { draw(series, "", "") }
+  if what ~= "error" then
+    -- by family; within one family, by technique (csm's seconds beside pcf's milliseconds)
+    local groups, order = group_by(series, function(s) return s.family end)
+    if #order == 1 then groups, order = group_by(series, function(s) return s.technique end) end
+    if #order > 1 and y_span(series) > 20 then
+      for _, g in ipairs(order) do files[#files + 1] = draw(groups[g], "-" .. slug(g), " (" .. g .. " only)") end
+    end
+  end
+  return files
 end
 
 ---------------------------------------------------------------- entry point
@@ -250,8 +351,10 @@ function report.write(result, opts)
     return nil
   end
   local ctx = { dir = result.out .. "/plots", time = opts.time or "frame" }
-  if not time_fields[ctx.time] then error("report: time must be frame, evaluate_median or evaluate_min", 2) end
-  ctx.err, ctx.err_label, ctx.noise = metric_getter(opts.error or "all.rmse")
+  if not time_fields[ctx.time] then
+    error(string.format("report.write: unknown time '%s'; valid: %s", tostring(ctx.time), table.concat(time_order, ", ")), 2)
+  end
+  ctx.err, ctx.err_label, ctx.noise, ctx.err_path = metric_getter(opts.error or "all.rmse")
   local rows = ok_rows(result.rows)
   local axes = swept_names(rows)
   mark_swept(rows, axes)
@@ -265,19 +368,24 @@ function report.write(result, opts)
     names_used[name] = true
     plots.time[#plots.time + 1] = { variant = v, file = error_vs_time(ctx, by_variant[h], name), rows = by_variant[h] }
   end
+  if #variant_order > 1 then plots.combined = error_vs_time(ctx, rows, "all-variants", true) end
   local by_scene, scene_order = group_by(rows, function(r) return r.variant.file end)
   for _, f in ipairs(scene_order) do
     local scene_name = slug(by_scene[f][1].variant.scene)
     for _, axis in ipairs(axes) do
-      for _, what in ipairs({ "error", "cost" }) do
-        local file = along_axis(ctx, axis, by_scene[f], scene_name, what)
-        if file then plots.axes[#plots.axes + 1] = { axis = axis, what = what, file = file } end
+      -- the error, the time plotted against it, and the evaluation alone (the frame time hides it)
+      local whats = { "error", ctx.time }
+      if ctx.time == "frame" then whats[3] = "evaluate_median" end
+      for _, what in ipairs(whats) do
+        for _, file in ipairs(along_axis(ctx, axis, by_scene[f], scene_name, what)) do
+          plots.axes[#plots.axes + 1] = { axis = axis, what = what, file = file }
+        end
       end
     end
   end
   local index = result.out .. "/index.html"
   html.write_index(index, { result = result, rows = result.rows, ok_rows = rows, plots = plots, opts = opts,
-                            err_label = ctx.err_label, time_label = time_fields[ctx.time], time = ctx.time,
+                            err_label = ctx.err_label, err_path = ctx.err_path, time_label = time_fields[ctx.time], time = ctx.time,
                             err = ctx.err, noise = ctx.noise })
   io.stderr:write("report: " .. index .. "\n")
   return index

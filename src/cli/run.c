@@ -47,7 +47,7 @@ static bool setup(Job *j, int stages, Error *err)
 {
     const CliOptions *o = &j->o;
     j->req = (CompareRequest){NULL, j->params, 0, o->repeat, o->warmup, (stages & STAGE_REFERENCE) != 0, o->ref,
-                              NULL, 0.0};
+                              NULL, 0.0, 0.0}; /* the CLI: each error PNG its own scale */
     if ((stages & STAGE_REFERENCE) && !reference_params_check(&o->ref, err)) return false;
     if (!(stages & STAGE_RENDER)) return true;
     if (!o->technique) return error_set(err, "missing -t TECHNIQUE (see shadowlab list)");

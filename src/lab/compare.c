@@ -5,7 +5,7 @@
 #include "core/hash.h"
 #include "core/timer.h"
 
-static bool compute_metrics(Lab *lab, CompareResult *out, Error *err)
+static bool compute_metrics(Lab *lab, double error_scale, CompareResult *out, Error *err)
 {
     double t0 = timer_now_s();
     const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), out->light_index, err);
@@ -15,7 +15,7 @@ static bool compute_metrics(Lab *lab, CompareResult *out, Error *err)
         !metrics_compute(v, out->ref, cls, term, &out->metrics, &out->signed_error, err))
         return false;
     out->metrics_s = timer_now_s() - t0;
-    out->error_scale = report_error_scale(out->metrics.region[REGION_ALL].max_abs);
+    out->error_scale = error_scale > 0 ? error_scale : report_error_scale(out->metrics.region[REGION_ALL].max_abs);
     out->compared = true;
     return true;
 }
@@ -32,7 +32,7 @@ static bool run_stages(Lab *lab, const CompareRequest *req, CompareResult *out, 
         out->ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &out->ref_info, err);
         if (!out->ref) return false;
     }
-    return !(req->tech && req->reference) || compute_metrics(lab, out, err);
+    return !(req->tech && req->reference) || compute_metrics(lab, req->error_scale, out, err);
 }
 
 bool lab_compare(Lab *lab, const CompareRequest *req, CompareResult *out, Error *err)

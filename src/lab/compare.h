@@ -17,6 +17,8 @@ typedef struct CompareRequest {
     ReferenceParams ref;
     const char *cache_dir;  /* NULL: no disk cache */
     double time_budget_s;   /* > 0: stop timed repeats after this long (lab.h RenderTiming) */
+    double error_scale;     /* > 0: |error| at full colour in the error PNG, fixed so a sweep's images
+                               compare; 0: the largest |error| rounded up to 1, 2 or 5 x 10^k */
 } CompareRequest;
 
 typedef struct CompareResult {

@@ -146,6 +146,7 @@ static bool run_evaluations(const RenderRequest *req, const RenderTiming *timing
     qsort(times, (size_t)n, sizeof(double), cmp_double);
     out->repeat = n;
     out->eval_min_s = times[0];
+    out->eval_max_s = times[n - 1];
     out->eval_median_s = n % 2 ? times[n / 2] : 0.5 * (times[n / 2 - 1] + times[n / 2]);
     free(times);
     return true;

@@ -41,7 +41,7 @@ typedef struct RenderResult {
     Image aux;             /* the technique's auxiliary channels (Technique.aux); empty when none */
     double view_s;         /* view samples + classes (0 when reused) */
     double prepare_s;      /* the technique's resource acquisition and set-up */
-    double eval_median_s, eval_min_s;
+    double eval_median_s, eval_min_s, eval_max_s; /* over the timed evaluations */
     int repeat;
     int warmup;
     /* What the technique's prepare depends on (a resources.h scope: what it

@@ -178,6 +178,7 @@ static void write_timings(JsonWriter *w, const RunReport *r)
         json_number(w, "prepare", r->render->prepare_s);
         json_number(w, "evaluate_median", r->render->eval_median_s);
         json_number(w, "evaluate_min", r->render->eval_min_s);
+        json_number(w, "evaluate_max", r->render->eval_max_s);
         json_int(w, "repeat", r->render->repeat);
         json_int(w, "warmup", r->render->warmup);
         /* frame = technique_build + prepare_own + evaluate_median (lab.h); the G-buffer's and

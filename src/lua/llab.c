@@ -184,7 +184,7 @@ int sl_lab_open(lua_State *L)
 
 static const char *const option_names[] = {"technique", "params", "light", "repeats", "warmup", "samples", "pattern",
                                            "seed", "measure", "cache", "out", "png", "exr", "print",
-                                           "time_budget", NULL};
+                                           "time_budget", "error_scale", NULL};
 
 static void check_option_names(lua_State *L, int idx, const char *method)
 {
@@ -306,6 +306,7 @@ static void read_options(lua_State *L, Lab *lab, const char *method, bool render
         o->req.repeat = opt_int(L, idx, "repeats", 1, 1, 10000);
         o->req.warmup = opt_int(L, idx, "warmup", 0, 0, 1000);
         o->req.time_budget_s = opt_number(L, idx, "time_budget", 0.0, 0.0, 1e6);
+        o->req.error_scale = opt_number(L, idx, "error_scale", 0.0, 0.0, 1e6); /* 0: per image */
     }
     o->req.reference = reference;
     read_reference_options(L, idx, o);

@@ -12,6 +12,7 @@ typedef struct LuaRun {
     CompareResult res;        /* render and signed error owned; res.ref not used */
     Image ref_value, ref_stderr;
     Image sample_class;       /* SampleClass per view sample (scene/light.h), as floats */
+    Image regions;            /* compared runs: each sample's Region (metrics_regions) */
 } LuaRun;
 
 static LuaRun *check_run(lua_State *L) { return luaL_checkudata(L, 1, SL_RUN_TYPE); }
@@ -72,6 +73,13 @@ void sl_push_run(lua_State *L, CompareResult *res, const RunReport *rep)
                      !copy_image(&res->ref->std_error, &run->ref_stderr, &err)))
         sl_raise(L, &err);
     if (!copy_classes(rep, &run->sample_class, &err)) sl_raise(L, &err);
+    if (res->compared) {
+        ResourceManager *rm = lab_resources(rep->lab);
+        const Scene *sc = lab_scene(rep->lab);
+        const uint8_t *cls = res_classes(rm, sc, res->light_index, &err);
+        const uint8_t *term = cls ? res_terminator(rm, sc, res->light_index, &err) : NULL;
+        if (!term || !metrics_regions(res->ref, cls, term, &run->regions, &err)) sl_raise(L, &err);
+    }
     /* Tell the collector about the images it cannot see, so a long sweep
      * collects finished Runs before their pixels pile up. */
     size_t pixels = image_count(&run->res.render.visibility) + image_count(&run->res.signed_error) +
@@ -102,13 +110,15 @@ static int run_metrics(lua_State *L)
 }
 
 /* run:image(name): a copy of "visibility", "reference", "stderr", "error" or
- * "class" (SampleClass per sample: 1 is a lit candidate, the samples scored). */
+ * "class" (SampleClass per sample: 1 is a lit candidate, the samples scored) or
+ * "region" (compared runs: each sample's region: 0 not scored, 1 penumbra,
+ * 2 umbra, 3 lit, 4 terminator, metrics.h's Region). */
 static int run_image(lua_State *L)
 {
     LuaRun *run = check_run(L);
-    static const char *const names[] = {"visibility", "reference", "stderr", "error", "class", NULL};
+    static const char *const names[] = {"visibility", "reference", "stderr", "error", "class", "region", NULL};
     const Image *images[] = {&run->res.render.visibility, &run->ref_value, &run->ref_stderr, &run->res.signed_error,
-                             &run->sample_class};
+                             &run->sample_class, &run->regions};
     int which = luaL_checkoption(L, 2, NULL, names);
     if (!images[which]->data) return luaL_error(L, "run:image: this run has no %s image", names[which]);
     sl_push_image_copy(L, images[which]);
@@ -122,6 +132,7 @@ static int run_gc(lua_State *L)
     image_free(&run->ref_value);
     image_free(&run->ref_stderr);
     image_free(&run->sample_class);
+    image_free(&run->regions);
     return 0;
 }
 

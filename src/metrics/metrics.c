@@ -62,6 +62,17 @@ static Region region_of(const float *ref, int nc, bool terminator)
     return v <= 0.01 ? REGION_UMBRA : v >= 0.99 ? REGION_LIT : REGION_PENUMBRA;
 }
 
+bool metrics_regions(const Reference *ref, const uint8_t *cls, const uint8_t *terminator, Image *out, Error *err)
+{
+    const Image *rv = &ref->value;
+    if (!image_init(out, rv->width, rv->height, 1, err)) return false;
+    for (int s = 0; s < rv->width * rv->height; s++)
+        out->data[s] = cls[s] != SAMPLE_LIT_CANDIDATE
+                           ? (float)REGION_ALL
+                           : (float)region_of(rv->data + (size_t)s * rv->channels, rv->channels, terminator && terminator[s]);
+    return true;
+}
+
 bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls, const uint8_t *terminator,
                      Metrics *m, Image *signed_error, Error *err)
 {

@@ -48,4 +48,9 @@ typedef struct Metrics {
 bool metrics_compute(const Image *est, const Reference *ref, const uint8_t *cls, const uint8_t *terminator,
                      Metrics *m, Image *signed_error, Error *err);
 
+/* The region each sample is scored in, as a Region value per sample (one
+ * channel, ref's size; REGION_ALL, 0, for a sample outside the evaluated
+ * class): what a report's pixel inspector shows under the cursor. */
+bool metrics_regions(const Reference *ref, const uint8_t *cls, const uint8_t *terminator, Image *out, Error *err);
+
 #endif

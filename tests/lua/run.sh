@@ -5,7 +5,7 @@
 # same sweep as 2 shards through GNU Parallel (and the Slurm script) merged
 # and compared with the unsharded run, merge refusals, the shipped
 # experiments at tiny sizes (error-vs-time's plots show every registered
-# technique), and the report opened in headless Chromium.
+# technique; each lab's questions cite what its index.html shows), and the report opened in headless Chromium.
 # Usage: tests/lua/run.sh build/shadowlab.
 # Prints "lua: N passed, N failed".
 set -u
@@ -100,7 +100,7 @@ done
 expect sweep_refuses_to_overwrite 1 "--resume" -- "$SL" run "$SWEEP" --out "$FULL" --quiet
 expect sweep_resume_of_a_finished_run_computes_nothing 0 "0 computed, 6 already recorded" -- \
     "$SL" run "$SWEEP" --out "$FULL" --resume
-for f in index.html plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg \
+for f in index.html plots/error-vs-time-all-variants.svg plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg \
          plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.png plots/error-vs-offset-scale-sphere-on-plane.svg \
          plots/cost-vs-lights-1-radius-sphere-on-plane.png; do
     [ -s "$FULL/$f" ] && ok "report_wrote_$(basename "$f")" || no "report_wrote_$(basename "$f")" "missing"
@@ -112,6 +112,18 @@ if grep -q "reference 16 samples, noise rms" "$FULL/plots/error-vs-time-sphere-o
    grep -q "64x48" "$FULL/plots/error-vs-time-sphere-on-plane-lights-1-radius-0-2.svg"; then
     ok plot_states_scene_resolution_samples_noise
 else no plot_states_scene_resolution_samples_noise "title"; fi
+
+# ---- the report's timing spread, load note and one error scale
+if "$SL" run tests/lua/report-checks.lua "$FULL" >"$TMP/err" 2>&1; then ok report_timing_spread_and_one_error_scale
+else no report_timing_spread_and_one_error_scale "$(head -1 "$TMP/err")"; fi
+for load in 99 0; do
+    rm -rf "$TMP/load" && cp -r "$FULL" "$TMP/load"
+    sed -i "s/\"loadavg_1min\":[0-9.]*/\"loadavg_1min\":$load/" "$TMP/load/records.jsonl"
+    "$SL" run "$SWEEP" --out "$TMP/load" --resume --quiet >/dev/null 2>&1
+    note=$(grep -c 'Load:</b> 6 of 6 rows' "$TMP/load/index.html")
+    want=$([ "$load" = 99 ] && echo 1 || echo 0)
+    [ "$note" -eq "$want" ] && ok "report_load_note_at_load_$load" || no "report_load_note_at_load_$load" "$note notes"
+done
 
 # ---- --fresh with other reference samples shows the new reference, not the old one under a new caption
 "$SL" run "$SWEEP" --out "$TMP/refs" --samples 4 --quiet >/dev/null 2>&1
@@ -216,10 +228,28 @@ TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeat 1 --warm
 expect error_vs_time_runs 0 "report:" -- "$SL" run experiments/error-vs-time.lua --factors 1 $TINY --out "$TMP/evt"
 expect error_vs_time_plot_shows_every_registered_technique 0 "every registered technique" -- \
     "$SL" run tests/lua/every-technique.lua "$TMP/evt"
+# the labs with images (their questions cite the signed-error images), then every question's citations
+LAB_TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeat 1 --warmup 0"
 expect lab_kernel_size_runs 0 "0 failed" "report:" -- \
-    "$SL" run experiments/lab-kernel-size.lua --techniques pcf $TINY --out "$TMP/lks"
-expect lab_light_radius_runs_a_shard 0 "0 failed" -- \
-    "$SL" run experiments/lab-light-radius.lua $TINY --shard 0/24 --out "$TMP/llr"
+    "$SL" run experiments/lab-kernel-size.lua $LAB_TINY --out "$TMP/lks"
+expect lab_kernel_size_questions_answerable_from_its_report 0 "5 questions answerable" -- \
+    "$SL" run tests/lua/lab-questions.lua lab-kernel-size "$TMP/lks"
+expect lab_light_radius_runs 0 "0 failed" "report:" -- \
+    "$SL" run experiments/lab-light-radius.lua --techniques hard,pcf $LAB_TINY --out "$TMP/llr"
+expect lab_light_radius_questions_answerable_from_its_report 0 "5 questions answerable" -- \
+    "$SL" run tests/lua/lab-questions.lua lab-light-radius "$TMP/llr"
+expect lab_aliasing_runs 0 "0 failed" "report:" -- \
+    "$SL" run experiments/lab-aliasing.lua $LAB_TINY --out "$TMP/lal"
+expect lab_aliasing_questions_answerable_from_its_report 0 "5 questions answerable" -- \
+    "$SL" run tests/lua/lab-questions.lua lab-aliasing "$TMP/lal"
+expect lab_aliasing_sweeps_a_scene_knob 0 "0 failed" "report:" -- \
+    "$SL" run experiments/lab-aliasing.lua $LAB_TINY --sweep gamma:60,120 --out "$TMP/lal-gamma"
+expect lab_aliasing_refuses_a_bad_sweep 1 "--sweep expects KNOB:V1,V2" -- \
+    "$SL" run experiments/lab-aliasing.lua $LAB_TINY --sweep frob:1,2 --out "$TMP/lal-bad"
+expect lab_light_radius_refuses_an_unknown_technique 1 "unknown technique 'pfc'" "registered: all," -- \
+    "$SL" run experiments/lab-light-radius.lua --techniques pfc $LAB_TINY --out "$TMP/llr-bad"
+expect report_refuses_an_unknown_metric 1 "unknown error metric 'penumbra_rmse'" "penumbra.rmse" "terminator" -- \
+    "$SL" run tests/lua/bad/unknown-metric.lua --out "$TMP/bad-metric"
 expect defaults_matrix_has_no_unexpected_umbra_leak 0 "0 unexpected umbra leaks above 0.10, 0 failed" -- "$SL" run experiments/defaults-matrix.lua --scenes sphere-on-plane.lua,contact.lua,textured-light.lua --set camera.width=48 --set camera.height=36 --samples 16 --out "$TMP/dm"
 
 # figure NAME CSV COLUMN LO HI [COL~TEXT ...] [--hold]: a figure the experiment computed, finite and in range
@@ -289,11 +319,11 @@ figure fig3_10_12_lispsm_helps_high_sun "$R/fig3-10-12-partitions/reproduction.c
     item~"high-sun: LiSPSM" --hold
 
 # ---- the report in headless Chromium: every image and plot loads, nothing logged
-browse() { # browse DIR: DOM after load in $TMP/dom.html, browser log in $TMP/browser.log
+browse() { # browse DIR [HASH]: DOM after load in $TMP/dom.html, browser log in $TMP/browser.log
     rm -rf "$TMP/profile"
     timeout 120 chromium --headless --no-sandbox --disable-gpu --disable-background-networking \
         --disable-component-update --disable-sync --no-first-run --user-data-dir="$TMP/profile" \
-        --enable-logging=stderr --v=0 --virtual-time-budget=10000 --dump-dom "file://$1/index.html" \
+        --enable-logging=stderr --v=0 --virtual-time-budget=10000 --dump-dom "file://$1/index.html${2:+#$2}" \
         >"$TMP/dom.html" 2>"$TMP/browser.log"
 }
 if command -v chromium >/dev/null; then
@@ -304,6 +334,12 @@ if command -v chromium >/dev/null; then
     else no browser_loads_every_image "$(grep -o 'id="load-status"[^<]*' "$TMP/dom.html")"; fi
     if grep -q "CONSOLE" "$TMP/browser.log"; then no browser_page_logs_nothing "$(grep CONSOLE "$TMP/browser.log" | head -2)"
     else ok browser_page_logs_nothing; fi
+    # the pixel inspector: click the first configuration, flip twice with f, read a penumbra pixel
+    xy=$("$SL" run tests/lua/inspector-check.lua pick "$FULL" 2>"$TMP/err")
+    browse "$FULL" "inspect-test=$xy"
+    if "$SL" run tests/lua/inspector-check.lua check "$FULL" "$TMP/dom.html" >"$TMP/err" 2>&1; then
+        ok browser_pixel_inspector_reads_the_engines_values
+    else no browser_pixel_inspector_reads_the_engines_values "$(head -1 "$TMP/err")"; fi
     cp -r "$FULL" "$TMP/broken" && rm "$TMP/broken/plots/cost-vs-offset-scale-sphere-on-plane.svg"
     browse "$TMP/broken"
     if grep -q 'data-missing="1"' "$TMP/dom.html"; then ok browser_check_sees_a_missing_plot
