@@ -105,9 +105,16 @@ local function accepted_below(t, p, value)
 end
 
 -- The points of a technique: its default, and FACTORS x default of its main
--- parameter, clamped to the parameter's range and to what the scenes accept.
+-- parameter, clamped to the parameter's range and to what the scenes accept;
+-- every choice of an enum main parameter, both values of a bool.
 local function points(t)
   local p = main_parameter(t)
+  if p and p.type == "enum" then -- a choice of method (shadow_volume's z-pass, z-fail, ZP+): each one
+    local list = {}
+    for _, c in ipairs(p.choices) do list[#list + 1] = { [p.name] = c } end
+    return list
+  end
+  if p and p.type == "bool" then return { { [p.name] = false }, { [p.name] = true } } end
   if not p or p.default == 0 then return { {} } end
   local list, seen = {}, {}
   for _, f in ipairs(FACTORS) do

@@ -250,7 +250,7 @@ expect lab_light_radius_refuses_an_unknown_technique 1 "unknown technique 'pfc'"
     "$SL" run experiments/lab-light-radius.lua --techniques pfc $LAB_TINY --out "$TMP/llr-bad"
 expect report_refuses_an_unknown_metric 1 "unknown error metric 'penumbra_rmse'" "penumbra.rmse" "terminator" -- \
     "$SL" run tests/lua/bad/unknown-metric.lua --out "$TMP/bad-metric"
-expect defaults_matrix_has_no_unexpected_umbra_leak 0 "0 unexpected umbra leaks above 0.10, 0 failed" -- "$SL" run experiments/defaults-matrix.lua --scenes sphere-on-plane.lua,contact.lua,textured-light.lua --set camera.width=48 --set camera.height=36 --samples 16 --out "$TMP/dm"
+expect defaults_matrix_has_no_unexpected_umbra_leak 0 "0 unexpected umbra leaks above 0.10, 0 failed" -- "$SL" run experiments/defaults-matrix.lua --scenes sphere-on-plane.lua,contact.lua,textured-light.lua --set camera.width=48 --set camera.height=36 --samples 16 --repeat 1 --warmup 0 --out "$TMP/dm"
 
 # figure NAME CSV COLUMN LO HI [COL~TEXT ...] [--hold]: a figure the experiment computed, finite and in range
 figure() { name=$1; shift; expect "$name" 0 "figures checked" -- "$SL" run tests/lua/figure.lua "$@"; }
@@ -307,7 +307,9 @@ figure course_fig2_2_bias_lowers_acne "$R/course-fig2.2-bias/reproduction.csv" m
     item~cones-and-hills quantity~acne --hold
 figure course_fig2_3_midpoint_fails "$R/course-fig2.3-midpoint/reproduction.csv" measured 0.01 50 \
     item~cones-and-hills quantity~"false lit"
-figure course_fig4_3_umbra_ratio "$R/course-fig4.3-pcf-umbra/reproduction.csv" measured 0.2 5 quantity~umbra
+# Fig. 4.3's four claims differ at full size too (160x120: the best K over-blurs), so all may differ here
+figure course_fig4_3_umbra_ratio "$R/course-fig4.3-pcf-umbra/reproduction.csv" measured 0.2 5 quantity~umbra \
+    --may-all-differ
 figure course_fig4_5_vsm_leaks "$R/course-fig4.5-vsm-bleeding/reproduction.csv" measured 0.001 1 item~"vsm - pcf" --hold
 figure course_fig4_7_gibbs_overshoot "$R/course-fig4.7-csm-terms/reproduction.csv" measured 8.5 9.5 \
     item~"M = 32" quantity~overshoot --hold
