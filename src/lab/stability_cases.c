@@ -296,6 +296,7 @@ static const KnownLimit inside_occluder_known[] = {
     {"adaptive_area", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_TEXTURED_RECT), UMBRA_MISSED, ONE_SIDED_MAP},
     {"shadow_width", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
     {"aliasing", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
+    {"pcss_prefiltered", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
     {NULL, 0, 0, NULL},
 };
 

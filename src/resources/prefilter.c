@@ -555,6 +555,38 @@ bool pf_fetch(const Prefiltered *pf, int face, const PfFootprint *fp, double *ou
     return fetch_sat(pf, face, fp, w, out);
 }
 
+/* ---- variable-size windows from a SAT ---- */
+
+/* The SAT's integral of channel c from the padded origin to the continuous
+ * padded point (X, Y), bilinear between the integer corners. */
+static double sat_integral(const Prefiltered *pf, size_t face0, double X, double Y, int c)
+{
+    int E = pf->stride + 1, C = pf->channels;
+    X = X < 0.0 ? 0.0 : X > E - 1 ? E - 1 : X;
+    Y = Y < 0.0 ? 0.0 : Y > E - 1 ? E - 1 : Y;
+    int I = clampi((int)floor(X), 0, E - 2), J = clampi((int)floor(Y), 0, E - 2);
+    double ax = X - I, ay = Y - J;
+#define S_(i_, j_) pf_get(&pf->data, (face0 + (size_t)(j_) * E + (i_)) * C + c)
+    return (1.0 - ay) * ((1.0 - ax) * S_(I, J) + ax * S_(I + 1, J)) + ay * ((1.0 - ax) * S_(I, J + 1) + ax * S_(I + 1, J + 1));
+#undef S_
+}
+
+bool pf_fetch_box(const Prefiltered *pf, int face, double s, double t, double hx, double hy, double *out)
+{
+    if (pf->kind != PREFILTER_SAT || pf->log) return false;
+    if (!(hx > 0.0 && hx <= PREFILTER_MAX_HALF && hy > 0.0 && hy <= PREFILTER_MAX_HALF)) return false;
+    int E = pf->stride + 1;
+    size_t face0 = (size_t)face * E * E;
+    double x0 = s - hx + pf->pad, x1 = s + hx + pf->pad, y0 = t - hy + pf->pad, y1 = t + hy + pf->pad;
+    double area = 4.0 * hx * hy;
+    for (int c = 0; c < pf->channels; c++) {
+        double sum = sat_integral(pf, face0, x1, y1, c) - sat_integral(pf, face0, x0, y1, c) -
+                     sat_integral(pf, face0, x1, y0, c) + sat_integral(pf, face0, x0, y0, c);
+        out[c] = sum / area + pf->offset[face * pf->channels + c];
+    }
+    return true;
+}
+
 /* ---- min-max pyramid ---- */
 
 static void pyramid_destroy(void *r)

@@ -114,6 +114,18 @@ static inline double pf_weight(const PfFootprint *fp, int k, double a)
  * PCF there); the values are then still finite. */
 bool pf_fetch(const Prefiltered *pf, int face, const PfFootprint *fp, double *out);
 
+/* The box average of every channel over the continuous window
+ * [s - hx, s + hx] x [t - hy, t + hy] of a face (map texel units: texel i
+ * covers [i, i + 1]), from a SAT of linear channels: the SAT is the integral
+ * of the piecewise-constant texels at integer corners, and that integral is
+ * bilinear inside each texel, so the SAT interpolated bilinearly at the four
+ * fractional corners is the exact sum with fractional edge weights (pcss's
+ * exhaustive box, course §5.2.2.2: "any rectangle in four texture fetches").
+ * Half-widths in (0, PREFILTER_MAX_HALF] texels; false (out untouched) for a
+ * box blur, a log channel or a half-width outside that range. */
+#define PREFILTER_MAX_HALF (PREFILTER_MAX_K / 2.0)
+bool pf_fetch_box(const Prefiltered *pf, int face, double s, double t, double hx, double hy, double *out);
+
 /* Min and max of the stored depth over mip levels (+INFINITY kept): the
  * window max for ESM's conservative classifier, the min for a lit early-out. */
 typedef struct MinMaxPyramid {
