@@ -57,6 +57,7 @@ int moment_channels(const MomentSpec *sp)
     case WARP_EXP: return sp->order;
     case WARP_FOURIER: return 2 * sp->order;
     case WARP_LOG_EXP: return 1;
+    case WARP_FOURIER_DEPTH: return 2 * sp->order + 1;
     }
     return 0;
 }
@@ -133,6 +134,11 @@ static void warp_texel(const MomentSpec *sp, double u, double dx, double dy, dou
     }
     case WARP_FOURIER: fourier_basis(u, sp->order, out); break;
     case WARP_LOG_EXP: out[0] = sp->c_pos * u; break; /* ln e^(c u) */
+    case WARP_FOURIER_DEPTH:
+        fourier_basis(u, sp->order, out + 1);
+        for (int k = 1; k <= 2 * sp->order; k++) out[k] *= u;
+        out[0] = u;
+        break;
     }
 }
 
@@ -192,7 +198,7 @@ static void *build_moments(const void *args, Error *err)
 
 static const char *warp_name(MomentWarp w)
 {
-    static const char *const names[] = {"powers", "layers", "exp", "fourier", "log-exp"};
+    static const char *const names[] = {"powers", "layers", "exp", "fourier", "log-exp", "fourier-depth"};
     return names[w];
 }
 

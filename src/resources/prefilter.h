@@ -34,6 +34,7 @@ typedef enum MomentWarp {
     WARP_EXP,      /* EVSM: e^(c+ (u - 1)), e^(2 c+ (u - 1)) [, -e^(-c- u), e^(-2 c- u)] (order 2 or 4) */
     WARP_FOURIER,  /* CSM (§4.2.3, Eq. 4.6): sin(c_k u), cos(c_k u), c_k = pi (2k - 1), k = 1..order */
     WARP_LOG_EXP,  /* ESM (§4.2.4): the log of exp(c u), i.e. c u: a log channel, filtered as log-sum-exp */
+    WARP_FOURIER_DEPTH, /* CSSM (course §5.2.2.3): u, then u sin(c_k u), u cos(c_k u), k = 1..order (2 order + 1) */
 } MomentWarp;
 
 typedef struct MomentSpec {

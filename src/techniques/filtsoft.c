@@ -77,3 +77,19 @@ bool filtsoft_blocker_mean(double mean_all, double lit, double d, double eps, do
     *z_occ = (mean_all - lit * d) / blocked;
     return isfinite(*z_occ);
 }
+
+void filtsoft_fourier_coefficients(int terms, double damping, double *coef)
+{
+    for (int k = 1; k <= terms; k++) {
+        double x = (double)k / terms;
+        coef[k - 1] = 2.0 * exp(-damping * x * x) / (M_PI * (2 * k - 1)); /* c_k = pi (2k - 1) */
+    }
+}
+
+double filtsoft_fourier_step(const double *coef, int terms, const double *m, double mean_w, double d)
+{
+    double at_d[PREFILTER_MAX_CHANNELS], sum = 0.5 * mean_w;
+    fourier_basis(d, terms, at_d);
+    for (int k = 0; k < terms; k++) sum += coef[k] * (at_d[2 * k + 1] * m[2 * k] - at_d[2 * k] * m[2 * k + 1]);
+    return sum;
+}

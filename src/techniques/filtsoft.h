@@ -1,5 +1,5 @@
 /* filtsoft.h -- what the constant-time filtered soft shadows share
- * (pcss_prefiltered: course §5.2.2.2): PCSS's geometry (course §5.2.2, pcss.c) in a map
+ * (pcss_prefiltered, cssm: course §5.2.2.2-3): PCSS's geometry (course §5.2.2, pcss.c) in a map
  * face's tangent frame (softmap.h) and the windows it sets, in texels:
  *   search half-width a (z_p - z_n) / (z_p z_n) / dx (the light-receiver
  *   pyramid on the near plane z_n),
@@ -11,7 +11,7 @@
  * normalised u in [0, 1] of prefilter.h, converted by filtsoft_linear.
  *
  * A SAT answers any window in four fetches per channel (pf_fetch_box), so
- * pcss_prefiltered costs the same at every light size. */
+ * pcss_prefiltered and cssm cost the same at every light size. */
 #ifndef SL_FILTSOFT_H
 #define SL_FILTSOFT_H
 #include "techniques/filtered.h"
@@ -66,6 +66,16 @@ const Prefiltered *filtsoft_sat(const TechContext *ctx, const FiltSoft *fs, Mome
  * so z_occ = (mean_all - lit d) / (1 - lit). false when 1 - lit < eps (no
  * blocker left to average, the caller's "lit"), or the result is not finite. */
 bool filtsoft_blocker_mean(double mean_all, double lit, double d, double eps, double *z_occ);
+
+/* CSM's truncated step (course Eq. 4.6, csm.c) at reference d, from a
+ * window's filtered basis pairs m[2k] = E w sin(c_k z), m[2k + 1] =
+ * E w cos(c_k z) and the mean E w of the weight the constant term 1/2
+ * multiplies (w = 1: the lit fraction; w = z: cssm's E z step(z - d)):
+ *   E w / 2 + sum_k coef_k (cos(c_k d) m[2k] - sin(c_k d) m[2k + 1]),
+ * coef_k = 2 exp(-a (k/M)^2) / c_k (csm's damping). */
+#define FILTSOFT_MAX_TERMS ((PREFILTER_MAX_CHANNELS - 1) / 2)
+void filtsoft_fourier_coefficients(int terms, double damping, double *coef);
+double filtsoft_fourier_step(const double *coef, int terms, const double *m, double mean_w, double d);
 
 /* The clamp of v to [0, 1], NaN kept (so a broken estimate shows). */
 static inline double filtsoft_unit_clamp(double v) { return v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v; }

@@ -19,6 +19,7 @@ extern const Technique tech_accumulation;
 extern const Technique tech_brabec;
 extern const Technique tech_pcss;
 extern const Technique tech_pcss_prefiltered;
+extern const Technique tech_cssm;
 extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
 extern const Technique tech_aliasing;
@@ -38,6 +39,7 @@ static const Technique *const registry[] = {
     &tech_brabec,
     &tech_pcss,
     &tech_pcss_prefiltered,
+    &tech_cssm,
     &tech_adaptive_area,
     &tech_shadow_width,
     &tech_aliasing,
