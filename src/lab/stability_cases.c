@@ -303,6 +303,8 @@ static const KnownLimit inside_occluder_known[] = {
      "course Fig. 4.8: the offset (0.1 of the depth range by default, against the period-2 series' 1/2 at z = d "
      "and z - d = -1) trades shadow for light leaking: receivers just outside the walls, within the offset of "
      "them in depth, are lit"},
+    {"evssm", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
+    {"dpcf", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
     {NULL, 0, 0, NULL},
 };
 

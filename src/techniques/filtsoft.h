@@ -1,5 +1,6 @@
 /* filtsoft.h -- what the constant-time filtered soft shadows share
- * (pcss_prefiltered, cssm: course §5.2.2.2-3): PCSS's geometry (course §5.2.2, pcss.c) in a map
+ * (pcss_prefiltered, cssm, evssm: course §5.2.2.2-3; dpcf, Filament's
+ * distance-based PCF): PCSS's geometry (course §5.2.2, pcss.c) in a map
  * face's tangent frame (softmap.h) and the windows it sets, in texels:
  *   search half-width a (z_p - z_n) / (z_p z_n) / dx (the light-receiver
  *   pyramid on the near plane z_n),
@@ -11,7 +12,7 @@
  * normalised u in [0, 1] of prefilter.h, converted by filtsoft_linear.
  *
  * A SAT answers any window in four fetches per channel (pf_fetch_box), so
- * pcss_prefiltered and cssm cost the same at every light size. */
+ * pcss_prefiltered, cssm and evssm cost the same at every light size. */
 #ifndef SL_FILTSOFT_H
 #define SL_FILTSOFT_H
 #include "techniques/filtered.h"

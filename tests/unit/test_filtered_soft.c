@@ -1,11 +1,15 @@
 /* test_filtered_soft.c -- the constant-time filtered soft shadows
- * (pcss_prefiltered, cssm: course §5.2.2.2-3):
+ * (pcss_prefiltered, cssm, evssm: course §5.2.2.2-3; dpcf, Filament's):
  *   - the SAT's variable-size window (pf_fetch_box) is the exact box with
  *     fractional edge weights that pcss's exhaustive filter reads;
  *   - where the papers claim accuracy, one planar occluder parallel to the
  *     receiver and to a square light (test_pcss.c's strip), each against
- *     the exact box convolution and Embree, with its bound.
- * 128 x 96 views, 256^2 maps, 256-sample references. */
+ *     the exact box convolution and Embree, with its bound;
+ *   - their failure, occluder fusion on overlap.lua (course Figs. 1.7, 5.19:
+ *     two occluders at different depths share one window; the map holds only
+ *     the high one where they overlap, and one average depth stands for
+ *     both): the signed error measured, the strip's bound broken.
+ * 128 x 96 and 160 x 120 views, 256^2 and 512^2 maps, 256-sample references. */
 #include <math.h>
 #include "fixtures.h"
 #include "resources/prefilter.h"
@@ -21,6 +25,9 @@
 #define LIGHT_WIDTH 1.0
 /* cssm: the damped series ripples about the box; measured max |e| 0.057 (M = 8), 0.030 (M = 16) */
 #define CSSM_STRIP_MAX 0.08
+/* dpcf: measured penumbra RMSE 0.064 against Embree (max |e| 0.197 against the exact convolution) */
+#define DPCF_STRIP_RMSE 0.10
+#define FUSION_BOUND (0.5 / 15.75 + 0.004) /* the strip's bound at its window */
 
 /* Overlap of texel [i, i + 1] with [a, b]. */
 static double overlap_1d(int i, double a, double b) { return fmax(0.0, fmin(i + 1.0, b) - fmax((double)i, a)); }
@@ -117,7 +124,7 @@ static bool strip_run(Lab *lab, const char *tech, const char *const *params, Str
     return vs && cls && m.nonfinite == 0;
 }
 
-/* The Chebyshev estimates: the window holds two depths, one the receiver's,
+/* The Chebyshev techniques: the window holds two depths, one the receiver's,
  * where the bound is exact (p = 1 - f; the blocker mean the occluder's), so
  * they are the exhaustive PCSS box and share its bound 0.5 / W (test_pcss.c:
  * the map moves an edge by at most half a texel), plus 0.004 of rounding
@@ -145,6 +152,8 @@ TEST(test_filtered_soft_pcss_prefiltered_is_the_box_convolution_on_parallel_plan
     check_chebyshev_strip("pcss_prefiltered");
 }
 
+TEST(test_filtered_soft_evssm_is_the_box_convolution_on_parallel_planes) { check_chebyshev_strip("evssm"); }
+
 /* cssm: the truncated Fourier step rings (Gibbs, damped; course §4.2.3) and
  * its transition spans about 1/M of the depth range, so its largest error
  * is wider than the box's bound (CSSM_STRIP_MAX, measured); its penumbra
@@ -166,6 +175,61 @@ TEST(test_filtered_soft_cssm_on_parallel_planes)
         CHECK_MSG(s.max_exact <= CSSM_STRIP_MAX, "max |e| %.4f above %.3f", s.max_exact, CSSM_STRIP_MAX);
         CHECK_MSG(s.penumbra_rmse <= bound + 2.0 * s.noise, "penumbra RMSE %.4f above %.4f + 2 noise",
                   s.penumbra_rmse, bound);
+    }
+    lab_close(lab);
+}
+
+/* dpcf: the kernel keeps the search window's width and only hardens, so on
+ * the strip, where PCSS's filter window is 1/2 of the search window
+ * ((z_p - z_b) / z_b = 1 at z_b = z_p / 2 against (z_p - z_n) / z_n), its
+ * penumbra is wrong by design: measured, and bounded from below so that a
+ * change that made it PCSS would be noticed. */
+TEST(test_filtered_soft_dpcf_on_parallel_planes)
+{
+    Lab *lab = square_light_strip();
+    CHECK(lab);
+    const char *p[] = {"map_size=256", NULL};
+    StripRun s;
+    CHECK(strip_run(lab, "dpcf", p, &s));
+    printf("    dpcf: max |e| against the exact convolution %.4f over %d penumbra samples; Embree penumbra RMSE %.4f "
+           "(noise %.4f)\n",
+           s.max_exact, s.penumbra, s.penumbra_rmse, s.noise);
+    CHECK(s.penumbra > 500);
+    CHECK_MSG(s.penumbra_rmse <= DPCF_STRIP_RMSE, "penumbra RMSE %.4f above %.3f", s.penumbra_rmse, DPCF_STRIP_RMSE);
+    CHECK_MSG(s.max_exact > 0.5 / s.window + 0.004, "dpcf met the box bound (max |e| %.4f)", s.max_exact);
+    lab_close(lab);
+}
+
+/* Occluder fusion on overlap.lua (course Figs. 1.7, 5.19; §5.2.2.1 issues
+ * 1-2) under a 0.9 x 0.9 rect light: where the high slab and the low slab
+ * share the search window one average depth stands for both, and the map
+ * holds only the high slab where they overlap. Signed error measured per
+ * region; the strip's bound is broken on a share of the penumbra. */
+TEST(test_filtered_soft_overlap_fusion_breaks_the_strip_bound)
+{
+    const char *light[] = {"lights[1]={type='rect', position={-1.0, 5.0, -1.5}, direction={0, -1, 0}, up={0, 0, -1}, "
+                           "width=0.9, height=0.9}",
+                           NULL};
+    Lab *lab = soft_open("overlap.lua", light);
+    CHECK(lab);
+    static const char *const techs[] = {"pcss", "pcss_prefiltered", "cssm", "evssm", "dpcf"};
+    for (size_t k = 0; k < sizeof techs / sizeof techs[0]; k++) {
+        const char *p[] = {"map_size=512", k == 0 ? "sampling=exhaustive" : NULL, NULL};
+        RenderResult r;
+        Metrics m;
+        Image e;
+        CHECK(soft_render(lab, techs[k], p, &r));
+        CHECK(signed_error(lab, &r.visibility, REF_SAMPLES, &m, &e));
+        double bound = FUSION_BOUND + 4.0 * m.noise_rms;
+        long over = signed_error_count(&e, -bound, bound), pen = m.region[REGION_PENUMBRA].count;
+        const ErrorStats *pe = &m.region[REGION_PENUMBRA], *um = &m.region[REGION_UMBRA];
+        printf("    %-16s penumbra RMSE %.4f signed %+.4f (leak %.4f, dark %.4f); umbra signed %+.4f; |e| > %.3f: %ld "
+               "samples (penumbra %ld)\n",
+               techs[k], pe->rmse, pe->mean_signed, pe->leak_mean, pe->dark_mean, um->mean_signed, bound, over, pen);
+        CHECK(m.nonfinite == 0 && outside_unit_range(&r.visibility) == 0);
+        CHECK_MSG(over > pen / 50, "%s: only %ld samples break the bound", techs[k], over);
+        image_free(&e);
+        render_result_free(&r);
     }
     lab_close(lab);
 }
