@@ -298,11 +298,6 @@ static const KnownLimit inside_occluder_known[] = {
     {"aliasing", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
     {"pcss_prefiltered", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
     {"cssm", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
-    /* measured: mean leak 0.0345-0.0371, 0.17-0.53% of the umbra lit; offset 0.02: 0.0087, none lit */
-    {"cssm", LIGHT_BIT(LIGHT_SPHERE), STAB_Q_UMBRA_LEAK,
-     "course Fig. 4.8: the offset (0.1 of the depth range by default, against the period-2 series' 1/2 at z = d "
-     "and z - d = -1) trades shadow for light leaking: receivers just outside the walls, within the offset of "
-     "them in depth, are lit"},
     {"evssm", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
     {"dpcf", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
     {NULL, 0, 0, NULL},

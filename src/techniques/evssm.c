@@ -97,10 +97,10 @@ static double evssm_visibility(const EvssmState *st, const SmapReceiver *r)
     FsWindow ws = filtsoft_search_window(&st->fs, r);
     if (!filtsoft_may_block(&st->fs, r, ws)) return 1.0;
     double u = filtsoft_unit(&st->fs, r), m[4], z_occ;
-    pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, ws.hx, ws.hy, m);
+    pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, ws.hx, ws.hy, 4, m);
     if (!evssm_blocker(st, m, u, &z_occ)) return 1.0;
     FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_occ));
-    pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, m);
+    pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 4, m);
     return evsm_bound(st, m, u);
 }
 

@@ -74,7 +74,7 @@ bool filtsoft_blocker_mean(double mean_all, double lit, double d, double eps, do
  * multiplies (w = 1: the lit fraction; w = z: cssm's E z step(z - d)):
  *   E w / 2 + sum_k coef_k (cos(c_k d) m[2k] - sin(c_k d) m[2k + 1]),
  * coef_k = 2 exp(-a (k/M)^2) / c_k (csm's damping). */
-#define FILTSOFT_MAX_TERMS ((PREFILTER_MAX_CHANNELS - 1) / 2)
+#define FILTSOFT_MAX_TERMS ((PREFILTER_MAX_CHANNELS - 1) / 4) /* cssm's 4M + 1 channels */
 void filtsoft_fourier_coefficients(int terms, double damping, double *coef);
 double filtsoft_fourier_step(const double *coef, int terms, const double *m, double mean_w, double d);
 

@@ -23,8 +23,9 @@
 #define STRIP_HEIGHT 2.0
 #define STRIP_HALF 0.75
 #define LIGHT_WIDTH 1.0
-/* cssm: the damped series ripples about the box; measured max |e| 0.057 (M = 8), 0.030 (M = 16) */
-#define CSSM_STRIP_MAX 0.08
+/* cssm: the damped series ripples about the box and its transition (2/M of the depth range) blurs the
+ * occluder's edge; measured max |e| 0.152 (M = 8), 0.119 (M = 15) */
+#define CSSM_STRIP_MAX 0.2
 /* dpcf: measured penumbra RMSE 0.064 against Embree (max |e| 0.197 against the exact convolution) */
 #define DPCF_STRIP_RMSE 0.10
 #define FUSION_BOUND (0.5 / 15.75 + 0.004) /* the strip's bound at its window */
@@ -79,12 +80,12 @@ TEST(test_filtered_soft_sat_window_is_the_exact_fractional_box)
     double worst = 0.0;
     for (size_t k = 0; k < sizeof w / sizeof w[0]; k++) {
         double m[2];
-        CHECK(pf_fetch_box(sat, 0, w[k][0], w[k][1], w[k][2], w[k][3], m));
+        CHECK(pf_fetch_box(sat, 0, w[k][0], w[k][1], w[k][2], w[k][3], 2, m));
         for (int c = 0; c < 2; c++) worst = fmax(worst, fabs(m[c] - brute_box(mm, c, w[k][0], w[k][1], w[k][2], w[k][3])));
     }
     double m[2];
-    CHECK(!pf_fetch_box(sat, 0, 10, 10, PREFILTER_MAX_HALF + 0.5, 1, m)); /* beyond the padding: refused */
-    CHECK(!pf_fetch_box(sat, 0, 10, 10, NAN, 1, m));
+    CHECK(!pf_fetch_box(sat, 0, 10, 10, PREFILTER_MAX_HALF + 0.5, 1, 2, m)); /* beyond the padding: refused */
+    CHECK(!pf_fetch_box(sat, 0, 10, 10, NAN, 1, 2, m));
     printf("    SAT window against the texel-by-texel fractional box: max |difference| %.3g\n", worst);
     CHECK_MSG(worst < 1e-9, "SAT window off the exact box by %.3g", worst);
     lab_close(lab);
@@ -155,14 +156,16 @@ TEST(test_filtered_soft_pcss_prefiltered_is_the_box_convolution_on_parallel_plan
 TEST(test_filtered_soft_evssm_is_the_box_convolution_on_parallel_planes) { check_chebyshev_strip("evssm"); }
 
 /* cssm: the truncated Fourier step rings (Gibbs, damped; course §4.2.3) and
- * its transition spans about 1/M of the depth range, so its largest error
- * is wider than the box's bound (CSSM_STRIP_MAX, measured); its penumbra
- * RMSE meets the box's bound. M = 8 (the default) and M = 16. */
+ * its transition spans about 2/M of the depth range (half depths, cssm.c),
+ * so its largest error is wider than the box's bound (CSSM_STRIP_MAX,
+ * measured); its penumbra RMSE meets the box's bound. The strip puts the
+ * occluder at u = 0 over the receiver at u = 1, the gap where a series on
+ * u returns 1/2 (RMSE 0.197 there). M = 8 (the default) and 15. */
 TEST(test_filtered_soft_cssm_on_parallel_planes)
 {
     Lab *lab = square_light_strip();
     CHECK(lab);
-    static const char *const terms[] = {"terms=8", "terms=16"};
+    static const char *const terms[] = {"terms=8", "terms=15"};
     for (int k = 0; k < 2; k++) {
         const char *p[] = {"map_size=256", terms[k], NULL};
         StripRun s;
