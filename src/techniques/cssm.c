@@ -100,18 +100,20 @@ static double step_at(const CssmState *st, const double *m, double d)
     return filtsoft_fourier_step(st->coef, st->terms, m, 1.0, 0.5 * d);
 }
 
-/* course §5.2.2.3: the average blocker depth over the search window; false: lit. */
+/* course §5.2.2.3: the average blocker depth over the search window; false: lit; NaN carried. */
 static bool cssm_blocker(const CssmState *st, const SmapReceiver *r, FsWindow w, double u, double *z_avg)
 {
     double m[PREFILTER_MAX_CHANNELS];
-    pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, w.hx, w.hy, st->sat->channels, m);
+    if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, w.hx, w.hy, st->sat->channels, m)) {
+        *z_avg = NAN; /* a NaN window: shown, not lit */
+        return true;
+    }
     const double *zm = m + 2 * st->terms; /* E z, then E z sin, E z cos */
     double d = 0.5 * (u - st->blocker_offset);
     double blocked = 1.0 - filtsoft_fourier_step(st->coef, st->terms, m, 1.0, d);
-    if (!(blocked >= st->lit_threshold)) return false;
+    if (blocked < st->lit_threshold) return false; /* a NaN passes on */
     double z_blocked = zm[0] - filtsoft_fourier_step(st->coef, st->terms, zm + 1, zm[0], d);
     double z = z_blocked / blocked;
-    if (z != z) return false;
     *z_avg = z < 0.0 ? 0.0 : z > u ? u : z;
     return true;
 }
@@ -123,7 +125,8 @@ static double cssm_visibility(const CssmState *st, const SmapReceiver *r)
     double u = filtsoft_unit(&st->fs, r), z_avg, m[PREFILTER_MAX_CHANNELS];
     if (!cssm_blocker(st, r, ws, u, &z_avg)) return 1.0;
     FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_avg));
-    pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 2 * st->terms, m); /* the basis only */
+    if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 2 * st->terms, m)) /* the basis only */
+        return NAN;
     return st->scale * step_at(st, m, u - st->offset);
 }
 

@@ -86,8 +86,8 @@ static bool evssm_blocker(const EvssmState *st, const double *m, double u, doubl
     double w_occ;
     if (!filtsoft_blocker_mean(m[0], positive_bound(st, m, u), exp(st->c_pos * (u - 1.0)), st->lit_eps, &w_occ))
         return false;
-    /* w_occ <= 0 is rounding below the smallest moment: blockers at the near plane */
-    double z = w_occ > 0.0 ? 1.0 + log(w_occ) / st->c_pos : 0.0;
+    /* w_occ <= 0 is rounding below the smallest moment: blockers at the near plane (NaN passes on) */
+    double z = w_occ > 0.0 ? 1.0 + log(w_occ) / st->c_pos : w_occ <= 0.0 ? 0.0 : w_occ;
     *z_occ = z < 0.0 ? 0.0 : z > u ? u : z;
     return true;
 }
@@ -97,10 +97,10 @@ static double evssm_visibility(const EvssmState *st, const SmapReceiver *r)
     FsWindow ws = filtsoft_search_window(&st->fs, r);
     if (!filtsoft_may_block(&st->fs, r, ws)) return 1.0;
     double u = filtsoft_unit(&st->fs, r), m[4], z_occ;
-    pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, ws.hx, ws.hy, 4, m);
+    if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, ws.hx, ws.hy, 4, m)) return NAN; /* a NaN window */
     if (!evssm_blocker(st, m, u, &z_occ)) return 1.0;
     FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_occ));
-    pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 4, m);
+    if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 4, m)) return NAN;
     return evsm_bound(st, m, u);
 }
 

@@ -12,13 +12,13 @@ bool filtsoft_init(FiltSoft *fs, const TechContext *ctx, double max_radius, cons
     return true;
 }
 
-/* Tangent half-widths -> texels, clamped to [FILTSOFT_MIN_HALF, max_radius];
- * a NaN width (a NaN depth upstream) becomes the widest window, never a value
- * that hides it: the estimate read there is then NaN-free but visibly wrong. */
+/* Tangent half-widths -> texels, clamped to [FILTSOFT_MIN_HALF, max_radius]
+ * by comparisons, so a NaN width (a NaN depth upstream) stays NaN: the SAT
+ * then refuses the window and the technique returns NaN, counted as
+ * non-finite, never a value that hides it. */
 static double clamp_half(double h, double max_radius)
 {
-    if (!(h >= FILTSOFT_MIN_HALF)) return h != h ? max_radius : FILTSOFT_MIN_HALF;
-    return h > max_radius ? max_radius : h;
+    return h < FILTSOFT_MIN_HALF ? FILTSOFT_MIN_HALF : h > max_radius ? max_radius : h;
 }
 
 static FsWindow window(const FiltSoft *fs, const SoftFace *f, double k)
@@ -73,9 +73,9 @@ const Prefiltered *filtsoft_sat(const TechContext *ctx, const FiltSoft *fs, Mome
 bool filtsoft_blocker_mean(double mean_all, double lit, double d, double eps, double *z_occ)
 {
     double blocked = 1.0 - lit;
-    if (!(blocked >= eps)) return false;
+    if (blocked < eps) return false; /* a NaN passes on into z_occ */
     *z_occ = (mean_all - lit * d) / blocked;
-    return isfinite(*z_occ);
+    return true;
 }
 
 void filtsoft_fourier_coefficients(int terms, double damping, double *coef)

@@ -65,7 +65,8 @@ const Prefiltered *filtsoft_sat(const TechContext *ctx, const FiltSoft *fs, Mome
  * mean_all, a fraction lit of texels at (or behind) the receiver's d and the
  * rest, the blockers, at their mean z_occ: mean_all = lit d + (1 - lit) z_occ,
  * so z_occ = (mean_all - lit d) / (1 - lit). false when 1 - lit < eps (no
- * blocker left to average, the caller's "lit"), or the result is not finite. */
+ * blocker left to average, the caller's "lit"); a NaN input gives a NaN
+ * z_occ, which the callers carry to a NaN result (counted non-finite). */
 bool filtsoft_blocker_mean(double mean_all, double lit, double d, double eps, double *z_occ);
 
 /* CSM's truncated step (course Eq. 4.6, csm.c) at reference d, from a

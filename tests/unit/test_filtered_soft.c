@@ -15,7 +15,7 @@
 #include "resources/prefilter.h"
 #include "signed_error.h"
 #include "soft_helpers.h"
-#include "techniques/smap.h"
+#include "techniques/filtsoft.h"
 #include "test.h"
 
 #define REF_SAMPLES 256
@@ -235,4 +235,16 @@ TEST(test_filtered_soft_overlap_fusion_breaks_the_strip_bound)
         render_result_free(&r);
     }
     lab_close(lab);
+}
+
+/* NaN never becomes "lit": Yang's blocker mean carries a NaN estimate on
+ * (the techniques then return NaN, counted non-finite), and only a blocked
+ * fraction below the threshold calls the receiver lit. */
+TEST(test_filtered_soft_blocker_mean_carries_nan)
+{
+    double z = 0.0;
+    CHECK(filtsoft_blocker_mean(0.5, NAN, 0.8, 1e-4, &z) && z != z);
+    CHECK(filtsoft_blocker_mean(NAN, 0.5, 0.8, 1e-4, &z) && z != z);
+    CHECK(!filtsoft_blocker_mean(0.8, 1.0, 0.8, 1e-4, &z));
+    CHECK(filtsoft_blocker_mean(0.5, 0.5, 0.8, 1e-4, &z) && fabs(z - 0.2) < 1e-12); /* 0.5 = 0.5 0.8 + 0.5 z */
 }
