@@ -302,6 +302,10 @@ static const KnownLimit inside_occluder_known[] = {
     {"occlusion_textures", LIGHT_BIT(LIGHT_SPHERE), STAB_Q_UMBRA_LEAK,
      "course §5.2.5: the slices' box-filtered values are multiplied, not united; walls whose depths spread over "
      "several slices each cover part of every kernel, so the product stays above 0 (no umbra sample lit)"},
+    {"pcss_prefiltered", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
+    {"cssm", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
+    {"evssm", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
+    {"dpcf", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
     {NULL, 0, 0, NULL},
 };
 

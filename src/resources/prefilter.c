@@ -58,6 +58,7 @@ int moment_channels(const MomentSpec *sp)
     case WARP_EXP: return sp->order;
     case WARP_FOURIER: return 2 * sp->order;
     case WARP_LOG_EXP: return 1;
+    case WARP_FOURIER_DEPTH: return 4 * sp->order + 1;
     }
     return 0;
 }
@@ -135,6 +136,13 @@ static void warp_texel(const MomentSpec *sp, double u, double dx, double dy, dou
     }
     case WARP_FOURIER: fourier_basis(u, sp->order, out); break;
     case WARP_LOG_EXP: out[0] = sp->c_pos * u; break; /* ln e^(c u) */
+    case WARP_FOURIER_DEPTH: {
+        int n = 2 * sp->order;
+        fourier_basis(0.5 * u, sp->order, out);
+        out[n] = u;
+        for (int k = 0; k < n; k++) out[n + 1 + k] = u * out[k];
+        break;
+    }
     }
 }
 
@@ -194,7 +202,7 @@ static void *build_moments(const void *args, Error *err)
 
 static const char *warp_name(MomentWarp w)
 {
-    static const char *const names[] = {"powers", "layers", "exp", "fourier", "log-exp"};
+    static const char *const names[] = {"powers", "layers", "exp", "fourier", "log-exp", "fourier-depth"};
     return names[w];
 }
 
@@ -555,6 +563,46 @@ bool pf_fetch(const Prefiltered *pf, int face, const PfFootprint *fp, double *ou
         return true;
     }
     return fetch_sat(pf, face, fp, w, out);
+}
+
+/* ---- variable-size windows from a SAT ---- */
+
+/* The SAT entries and weights whose sum is the integral from the padded
+ * origin to the continuous padded point (X, Y): bilinear between the four
+ * integer corners around it, each weight times `sign`. */
+static void sat_corner(const Prefiltered *pf, size_t face0, double X, double Y, double sign, size_t *at, double *w)
+{
+    int E = pf->stride + 1, C = pf->channels;
+    X = X < 0.0 ? 0.0 : X > E - 1 ? E - 1 : X;
+    Y = Y < 0.0 ? 0.0 : Y > E - 1 ? E - 1 : Y;
+    int I = clampi((int)floor(X), 0, E - 2), J = clampi((int)floor(Y), 0, E - 2);
+    double ax = X - I, ay = Y - J;
+    for (int k = 0; k < 4; k++) {
+        int di = k & 1, dj = k >> 1;
+        at[k] = (face0 + (size_t)(J + dj) * E + (I + di)) * C;
+        w[k] = sign * (di ? ax : 1.0 - ax) * (dj ? ay : 1.0 - ay);
+    }
+}
+
+bool pf_fetch_box(const Prefiltered *pf, int face, double s, double t, double hx, double hy, int channels,
+                  double *out)
+{
+    if (pf->kind != PREFILTER_SAT || pf->log || channels < 1 || channels > pf->channels) return false;
+    if (!(hx > 0.0 && hx <= PREFILTER_MAX_HALF && hy > 0.0 && hy <= PREFILTER_MAX_HALF)) return false;
+    int E = pf->stride + 1;
+    size_t face0 = (size_t)face * E * E, at[16];
+    double w[16], x0 = s - hx + pf->pad, x1 = s + hx + pf->pad, y0 = t - hy + pf->pad, y1 = t + hy + pf->pad;
+    sat_corner(pf, face0, x1, y1, 1.0, at, w);
+    sat_corner(pf, face0, x0, y1, -1.0, at + 4, w + 4);
+    sat_corner(pf, face0, x1, y0, -1.0, at + 8, w + 8);
+    sat_corner(pf, face0, x0, y0, 1.0, at + 12, w + 12);
+    double inv_area = 1.0 / (4.0 * hx * hy);
+    for (int c = 0; c < channels; c++) {
+        double sum = 0.0;
+        for (int k = 0; k < 16; k++) sum += w[k] * pf_get(&pf->data, at[k] + c);
+        out[c] = sum * inv_area + pf->offset[face * pf->channels + c];
+    }
+    return true;
 }
 
 /* ---- min-max pyramid ---- */

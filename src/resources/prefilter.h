@@ -34,6 +34,9 @@ typedef enum MomentWarp {
     WARP_EXP,      /* EVSM: e^(c+ (u - 1)), e^(2 c+ (u - 1)) [, -e^(-c- u), e^(-2 c- u)] (order 2 or 4) */
     WARP_FOURIER,  /* CSM (§4.2.3, Eq. 4.6): sin(c_k u), cos(c_k u), c_k = pi (2k - 1), k = 1..order */
     WARP_LOG_EXP,  /* ESM (§4.2.4): the log of exp(c u), i.e. c u: a log channel, filtered as log-sum-exp */
+    WARP_FOURIER_DEPTH, /* CSSM (course §5.2.2.3): at v = u / 2, sin(c_k v), cos(c_k v) (2 order), then u,
+                           u sin(c_k v), u cos(c_k v) (2 order + 1): 4 order + 1 channels; the half depth keeps
+                           |v_z - v_d| <= 1/2, inside the series' period of 2 */
 } MomentWarp;
 
 typedef struct MomentSpec {
@@ -113,6 +116,20 @@ static inline double pf_weight(const PfFootprint *fp, int k, double a)
  * a log SAT's window sum is below its rounding error (ESM falls back to
  * PCF there); the values are then still finite. */
 bool pf_fetch(const Prefiltered *pf, int face, const PfFootprint *fp, double *out);
+
+/* The box average of every channel over the continuous window
+ * [s - hx, s + hx] x [t - hy, t + hy] of a face (map texel units: texel i
+ * covers [i, i + 1]), from a SAT of linear channels: the SAT is the integral
+ * of the piecewise-constant texels at integer corners, and that integral is
+ * bilinear inside each texel, so the SAT interpolated bilinearly at the four
+ * fractional corners is the exact sum with fractional edge weights (pcss's
+ * exhaustive box, course §5.2.2.2: "any rectangle in four texture fetches").
+ * The first `channels` channels; half-widths in (0, PREFILTER_MAX_HALF]
+ * texels; false (out untouched) for a box blur, a log channel, a channel
+ * count outside [1, pf->channels] or a half-width outside that range. */
+#define PREFILTER_MAX_HALF (PREFILTER_MAX_K / 2.0)
+bool pf_fetch_box(const Prefiltered *pf, int face, double s, double t, double hx, double hy, int channels,
+                  double *out);
 
 /* Min and max of the stored depth over mip levels (+INFINITY kept): the
  * window max for ESM's conservative classifier, the min for a lit early-out. */

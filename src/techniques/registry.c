@@ -19,6 +19,10 @@ extern const Technique tech_single_sample_rt;
 extern const Technique tech_accumulation;
 extern const Technique tech_brabec;
 extern const Technique tech_pcss;
+extern const Technique tech_pcss_prefiltered;
+extern const Technique tech_cssm;
+extern const Technique tech_evssm;
+extern const Technique tech_dpcf;
 extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
 extern const Technique tech_aliasing;
@@ -41,6 +45,10 @@ static const Technique *const registry[] = {
     &tech_accumulation,
     &tech_brabec,
     &tech_pcss,
+    &tech_pcss_prefiltered,
+    &tech_cssm,
+    &tech_evssm,
+    &tech_dpcf,
     &tech_adaptive_area,
     &tech_shadow_width,
     &tech_aliasing,

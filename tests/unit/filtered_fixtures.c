@@ -47,6 +47,7 @@ bool filtered_render(Lab *lab, const char *tech, const char *list, RenderResult 
 
 bool filtered_acquires_moments(const Technique *t)
 {
+    if (strcmp(t->family, "filtered") != 0) return false; /* the soft family's prefiltered PCSS: test_filtered_soft.c */
     for (int i = 0; t->resources[i]; i++)
         if (strcmp(t->resources[i], "moments") == 0) return true;
     return false;

@@ -1,0 +1,137 @@
+/* evssm.c -- `evssm`: PCSS on an exponential variance shadow map (EVSM,
+ * course §4.2.4; Lauritzen & McCool 2008), both windows read from one
+ * summed-area table of the four warped moments (course §5.2.2.2), so a
+ * receiver costs two lookups at any light size:
+ *   1. blocker average: on the positive warp w(u) = e^(c+ (u - 1)) (stored
+ *      scaled by e^-c+, prefilter.c), Chebyshev's bound p on the lit
+ *      fraction at the receiver's w(d) and Yang et al. 2010's estimate
+ *      (VSSM §4) in the warped domain, w_occ = (E w - p w(d)) / (1 - p),
+ *      mapped back through the warp: z_occ = 1 + ln(w_occ) / c+ [OWN: the
+ *      estimate carried to the exponential moments]. By Jensen's inequality
+ *      that is at least the blockers' mean depth, exact for one depth;
+ *   2. the filter window from z_occ (course §5.2.2 step 2);
+ *   3. EVSM over it: the smaller Chebyshev bound of the two warps
+ *      (course §4.2.4, the warp pair erratum: +e^(c+ u), -e^(-c- u)).
+ * A SAT's absolute rounding error is about eps times the face's moment sum
+ * (prefilter.h); moments below it (e^(2 c+ (u - 1)) for deep blockers at
+ * large c+) are noise, so the exponents default lower than evsm's box blur. */
+#include <stdlib.h>
+#include "techniques/filtsoft.h"
+
+enum { P_MAX_RADIUS = SMAP_NUM_DEPTH_BIAS_PARAMS, P_PRECISION, P_CPOS, P_CNEG, P_MIN_VAR, P_LIT_EPS };
+
+static const ParamDesc evssm_params[] = {
+    /* perspective faces (softmap.h), one cascade: a prefiltered table per face (with cascades, split_scheme
+     * and split_lambda changed no output on the parameter test's scenes) */
+    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_CUBE, 1, SPLIT_EXPLICIT),
+    SMAP_DEPTH_BIAS_PARAMS, /* one reference depth against a prefiltered window */
+    FILTSOFT_MAX_RADIUS_PARAM(31),
+    FILTSOFT_PRECISION_PARAM,
+    {"exponent_pos", PARAM_FLOAT, 10, 0.1, 80, "1 / normalised depth",
+     "c+ of the warp exp(c+ u); the second moment spans e^(-2 c+), and a summed-area table's rounding (about "
+     "1e-16 of the face's sum in f64, 1e-7 in f32) swamps what lies below it",
+     NULL},
+    {"exponent_neg", PARAM_FLOAT, 10, 0.1, 80, "1 / normalised depth", "c- of the negative warp -exp(-c- u)", NULL},
+    {"min_variance", PARAM_FLOAT, 1e-6, 0, 0.25, "normalised depth^2",
+     "lower clamp of each window's variance, scaled by the warp's slope at the receiver as evsm's", NULL},
+    {"lit_threshold", PARAM_FLOAT, 1e-4, 1e-9, 0.5, "fraction",
+     "the search window's blocked fraction 1 - p below which the receiver is lit: the blocker mean divides by it",
+     NULL},
+};
+FILTER_CHECK_TABLE(evssm_params);
+
+static const char *const evssm_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", "moments", "sat", NULL};
+
+typedef struct EvssmState {
+    FiltSoft fs;
+    const Prefiltered *sat;
+    double c_pos, c_neg, min_variance, lit_eps;
+} EvssmState;
+
+static bool evssm_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    const double *p = ctx->params;
+    EvssmState *st = calloc(1, sizeof *st);
+    if (!st) return error_set(err, "out of memory");
+    *st = (EvssmState){.c_pos = p[P_CPOS], .c_neg = p[P_CNEG], .min_variance = p[P_MIN_VAR], .lit_eps = p[P_LIT_EPS]};
+    MomentSpec spec = {.warp = WARP_EXP, .order = 4, .c_pos = st->c_pos, .c_neg = st->c_neg,
+                       .f64 = (int)p[P_PRECISION] == 0};
+    if (!filtsoft_init(&st->fs, ctx, p[P_MAX_RADIUS], false, "evssm", err) ||
+        !(st->sat = filtsoft_sat(ctx, &st->fs, spec, err))) {
+        free(st);
+        return false;
+    }
+    *state = st;
+    return true;
+}
+
+/* Chebyshev on the positive warp at the receiver, the clamp scaled by the
+ * warp's slope there (w' = c w), as evsm's. */
+static double positive_bound(const EvssmState *st, const double *m, double u)
+{
+    double w = exp(st->c_pos * (u - 1.0)), slope = st->c_pos * w;
+    return chebyshev_upper(m[0], m[1], w, st->min_variance * slope * slope);
+}
+
+/* course §4.2.4: p = min(p+, p-). */
+static double evsm_bound(const EvssmState *st, const double *m, double u)
+{
+    double p = positive_bound(st, m, u);
+    double w = exp(-st->c_neg * u), slope = st->c_neg * w;
+    double q = chebyshev_upper(m[2], m[3], -w, st->min_variance * slope * slope);
+    return q < p ? q : p;
+}
+
+/* Step 1: the blockers' normalised depth; false: lit. */
+static bool evssm_blocker(const EvssmState *st, const double *m, double u, double *z_occ)
+{
+    double w_occ;
+    if (!filtsoft_blocker_mean(m[0], positive_bound(st, m, u), exp(st->c_pos * (u - 1.0)), st->lit_eps, &w_occ))
+        return false;
+    /* w_occ <= 0 is rounding below the smallest moment: blockers at the near plane (NaN passes on) */
+    double z = w_occ > 0.0 ? 1.0 + log(w_occ) / st->c_pos : w_occ <= 0.0 ? 0.0 : w_occ;
+    *z_occ = z < 0.0 ? 0.0 : z > u ? u : z;
+    return true;
+}
+
+static double evssm_visibility(const EvssmState *st, const SmapReceiver *r)
+{
+    FsWindow ws = filtsoft_search_window(&st->fs, r);
+    if (!filtsoft_may_block(&st->fs, r, ws)) return 1.0;
+    double u = filtsoft_unit(&st->fs, r), m[4], z_occ;
+    if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, ws.hx, ws.hy, 4, m)) return NAN; /* a NaN window */
+    if (!evssm_blocker(st, m, u, &z_occ)) return 1.0;
+    FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_occ));
+    if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 4, m)) return NAN;
+    return evsm_bound(st, m, u);
+}
+
+static void evssm_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
+{
+    const EvssmState *st = state;
+    for (int s = begin; s < end; s++) {
+        if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        SmapReceiver r;
+        double v = 1.0;
+        if (smap_receiver(st->fs.sm.map, &st->fs.bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r))
+            v = evssm_visibility(st, &r);
+        tech_store(ctx, out, begin, s, (float)filtsoft_unit_clamp(v));
+    }
+}
+
+const Technique tech_evssm = {
+    .name = "evssm",
+    .family = "soft",
+    .source = "course §4.2.4 (EVSM), §5.2.2.2 (SAT); blocker mean of Yang et al. 2010 §4 on the warped moments",
+    .summary = "PCSS from one summed-area table of EVSM's four moments: the blocker mean from the positive "
+               "warp's Chebyshev bound, then EVSM's min of two bounds over the penumbra window",
+    .params = evssm_params,
+    .num_params = (int)(sizeof evssm_params / sizeof evssm_params[0]),
+    .resources = evssm_resources,
+    .rgb = false,
+    .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),
+    .main_param = "exponent_pos",
+    .prepare = evssm_prepare,
+    .evaluate = evssm_evaluate,
+    .release = free,
+};

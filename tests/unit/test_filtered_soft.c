@@ -1,0 +1,250 @@
+/* test_filtered_soft.c -- the constant-time filtered soft shadows
+ * (pcss_prefiltered, cssm, evssm: course §5.2.2.2-3; dpcf, Filament's):
+ *   - the SAT's variable-size window (pf_fetch_box) is the exact box with
+ *     fractional edge weights that pcss's exhaustive filter reads;
+ *   - where the papers claim accuracy, one planar occluder parallel to the
+ *     receiver and to a square light (test_pcss.c's strip), each against
+ *     the exact box convolution and Embree, with its bound;
+ *   - their failure, occluder fusion on overlap.lua (course Figs. 1.7, 5.19:
+ *     two occluders at different depths share one window; the map holds only
+ *     the high one where they overlap, and one average depth stands for
+ *     both): the signed error measured, the strip's bound broken.
+ * 128 x 96 and 160 x 120 views, 256^2 and 512^2 maps, 256-sample references. */
+#include <math.h>
+#include "fixtures.h"
+#include "resources/prefilter.h"
+#include "signed_error.h"
+#include "soft_helpers.h"
+#include "techniques/filtsoft.h"
+#include "test.h"
+
+#define REF_SAMPLES 256
+#define LIGHT_HEIGHT 4.0
+#define STRIP_HEIGHT 2.0
+#define STRIP_HALF 0.75
+#define LIGHT_WIDTH 1.0
+/* cssm: the damped series ripples about the box and its transition (2/M of the depth range) blurs the
+ * occluder's edge; measured max |e| 0.152 (M = 8), 0.119 (M = 15) */
+#define CSSM_STRIP_MAX 0.2
+/* dpcf: measured penumbra RMSE 0.064 against Embree (max |e| 0.197 against the exact convolution) */
+#define DPCF_STRIP_RMSE 0.10
+#define FUSION_BOUND (0.5 / 15.75 + 0.004) /* the strip's bound at its window */
+
+/* Overlap of texel [i, i + 1] with [a, b]. */
+static double overlap_1d(int i, double a, double b) { return fmax(0.0, fmin(i + 1.0, b) - fmax((double)i, a)); }
+
+/* The box average of channel c over [s - hx, s + hx] x [t - hy, t + hy], texel by texel, edges clamped. */
+static double brute_box(const MomentMap *mm, int c, double s, double t, double hx, double hy)
+{
+    double sum = 0.0;
+    for (int j = (int)floor(t - hy); j <= (int)floor(t + hy); j++) {
+        double wy = overlap_1d(j, t - hy, t + hy);
+        int jc = j < 0 ? 0 : j >= mm->res ? mm->res - 1 : j;
+        for (int i = (int)floor(s - hx); i <= (int)floor(s + hx); i++) {
+            int ic = i < 0 ? 0 : i >= mm->res ? mm->res - 1 : i;
+            sum += wy * overlap_1d(i, s - hx, s + hx) * pf_get(&mm->data, ((size_t)jc * mm->res + ic) * mm->channels + c);
+        }
+    }
+    return sum / (4.0 * hx * hy);
+}
+
+static Lab *square_light_strip(void)
+{
+    return soft_strip("{ type = 'rect', position = {0, 4, 0}, direction = {0, -1, 0}, up = {0, 0, 1}, "
+                      "width = 1, height = 1 }",
+                      STRIP_HEIGHT);
+}
+
+TEST(test_filtered_soft_sat_window_is_the_exact_fractional_box)
+{
+    Lab *lab = square_light_strip();
+    CHECK(lab);
+    Error err;
+    const Technique *t = tech_find("pcss_prefiltered", &err);
+    CHECK(t);
+    double p[TECH_MAX_PARAMS];
+    tech_params_default(t, p);
+    p[SMAP_P_MAP_SIZE] = 64;
+    ShadowMapSpec spec = smap_spec(p);
+    ResourceManager *rm = lab_resources(lab);
+    const ShadowMap *map = res_shadow_map(rm, lab_scene(lab), 0, &spec, &err);
+    CHECK(map && map->num_faces == 1);
+    MomentSpec ms = {.warp = WARP_POWERS, .order = 2, .f64 = true};
+    const MomentMap *mm = res_moment_map(rm, map, &ms, &err);
+    CHECK(mm);
+    const Prefiltered *sat = res_prefiltered(rm, mm, PREFILTER_SAT, 1, &err);
+    CHECK(sat);
+    /* windows inside, across the strip's edges and over the face's border (edge replication) */
+    static const double w[][4] = {{31.3, 20.7, 0.5, 0.5}, {17.25, 40.6, 3.3, 7.9}, {2.1, 60.2, 11.45, 5.05},
+                                  {63.9, 0.2, 31.5, 31.5}, {40.0, 33.0, 12.0, 12.0}, {25.77, 31.01, 9.13, 0.61}};
+    double worst = 0.0;
+    for (size_t k = 0; k < sizeof w / sizeof w[0]; k++) {
+        double m[2];
+        CHECK(pf_fetch_box(sat, 0, w[k][0], w[k][1], w[k][2], w[k][3], 2, m));
+        for (int c = 0; c < 2; c++) worst = fmax(worst, fabs(m[c] - brute_box(mm, c, w[k][0], w[k][1], w[k][2], w[k][3])));
+    }
+    double m[2];
+    CHECK(!pf_fetch_box(sat, 0, 10, 10, PREFILTER_MAX_HALF + 0.5, 1, 2, m)); /* beyond the padding: refused */
+    CHECK(!pf_fetch_box(sat, 0, 10, 10, NAN, 1, 2, m));
+    printf("    SAT window against the texel-by-texel fractional box: max |difference| %.3g\n", worst);
+    CHECK_MSG(worst < 1e-9, "SAT window off the exact box by %.3g", worst);
+    lab_close(lab);
+}
+
+/* test_pcss.c's exact answer: visibility at ground point x under the 1 x 1 square light. */
+static double strip_exact(double x)
+{
+    double k = STRIP_HEIGHT / LIGHT_HEIGHT, w = LIGHT_WIDTH;
+    double a0 = (-STRIP_HALF - x * (1.0 - k)) / k, a1 = (STRIP_HALF - x * (1.0 - k)) / k;
+    double hidden = fmax(0.0, fmin(0.5 * w, a1) - fmax(-0.5 * w, a0));
+    return 1.0 - hidden / w;
+}
+
+typedef struct StripRun { double max_exact, penumbra_rmse, noise, window; int penumbra; } StripRun;
+
+static bool strip_run(Lab *lab, const char *tech, const char *const *params, StripRun *out)
+{
+    RenderResult r;
+    Metrics m;
+    Error err;
+    if (!soft_render(lab, tech, params, &r) || !soft_metrics(lab, &r.visibility, REF_SAMPLES, &m)) return false;
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    *out = (StripRun){0};
+    for (int s = 0; vs && cls && s < vs->count; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        double e = strip_exact(vs->p_world[s].x);
+        out->max_exact = fmax(out->max_exact, fabs(r.visibility.data[s] - e));
+        out->penumbra += e > 0.0 && e < 1.0;
+    }
+    out->penumbra_rmse = m.region[REGION_PENUMBRA].rmse;
+    out->noise = m.region[REGION_PENUMBRA].noise_rms;
+    double z_p = LIGHT_HEIGHT, z_b = LIGHT_HEIGHT - STRIP_HEIGHT;
+    out->window = LIGHT_WIDTH * (z_p - z_b) / (z_p * z_b) / soft_map_dx(lab, tech, 256);
+    render_result_free(&r);
+    return vs && cls && m.nonfinite == 0;
+}
+
+/* The Chebyshev techniques: the window holds two depths, one the receiver's,
+ * where the bound is exact (p = 1 - f; the blocker mean the occluder's), so
+ * they are the exhaustive PCSS box and share its bound 0.5 / W (test_pcss.c:
+ * the map moves an edge by at most half a texel), plus 0.004 of rounding
+ * (min_variance against the occluder-receiver gap). */
+static void check_chebyshev_strip(const char *tech)
+{
+    Lab *lab = square_light_strip();
+    CHECK(lab);
+    const char *p[] = {"map_size=256", NULL};
+    StripRun s;
+    CHECK(strip_run(lab, tech, p, &s));
+    double bound = 0.5 / s.window + 0.004;
+    printf("    %s: window %.2f texels, bound %.4f; max |e| against the exact convolution %.4f over %d penumbra "
+           "samples; Embree (256 stratified) penumbra RMSE %.4f (noise %.4f)\n",
+           tech, s.window, bound, s.max_exact, s.penumbra, s.penumbra_rmse, s.noise);
+    CHECK_MSG(s.penumbra > 500, "the strip lost its penumbra (%d samples)", s.penumbra);
+    CHECK_MSG(s.max_exact <= bound, "max |e| %.4f above %.4f", s.max_exact, bound);
+    CHECK_MSG(s.penumbra_rmse <= bound + 2.0 * s.noise, "Embree penumbra RMSE %.4f above %.4f + 2 noise",
+              s.penumbra_rmse, bound);
+    lab_close(lab);
+}
+
+TEST(test_filtered_soft_pcss_prefiltered_is_the_box_convolution_on_parallel_planes)
+{
+    check_chebyshev_strip("pcss_prefiltered");
+}
+
+TEST(test_filtered_soft_evssm_is_the_box_convolution_on_parallel_planes) { check_chebyshev_strip("evssm"); }
+
+/* cssm: the truncated Fourier step rings (Gibbs, damped; course §4.2.3) and
+ * its transition spans about 2/M of the depth range (half depths, cssm.c),
+ * so its largest error is wider than the box's bound (CSSM_STRIP_MAX,
+ * measured); its penumbra RMSE meets the box's bound. The strip puts the
+ * occluder at u = 0 over the receiver at u = 1, the gap where a series on
+ * u returns 1/2 (RMSE 0.197 there). M = 8 (the default) and 15. */
+TEST(test_filtered_soft_cssm_on_parallel_planes)
+{
+    Lab *lab = square_light_strip();
+    CHECK(lab);
+    static const char *const terms[] = {"terms=8", "terms=15"};
+    for (int k = 0; k < 2; k++) {
+        const char *p[] = {"map_size=256", terms[k], NULL};
+        StripRun s;
+        CHECK(strip_run(lab, "cssm", p, &s));
+        printf("    cssm %s: window %.2f texels; max |e| against the exact convolution %.4f over %d penumbra samples; "
+               "Embree penumbra RMSE %.4f (noise %.4f)\n",
+               terms[k], s.window, s.max_exact, s.penumbra, s.penumbra_rmse, s.noise);
+        double bound = 0.5 / s.window + 0.004;
+        CHECK(s.penumbra > 500);
+        CHECK_MSG(s.max_exact <= CSSM_STRIP_MAX, "max |e| %.4f above %.3f", s.max_exact, CSSM_STRIP_MAX);
+        CHECK_MSG(s.penumbra_rmse <= bound + 2.0 * s.noise, "penumbra RMSE %.4f above %.4f + 2 noise",
+                  s.penumbra_rmse, bound);
+    }
+    lab_close(lab);
+}
+
+/* dpcf: the kernel keeps the search window's width and only hardens, so on
+ * the strip, where PCSS's filter window is 1/2 of the search window
+ * ((z_p - z_b) / z_b = 1 at z_b = z_p / 2 against (z_p - z_n) / z_n), its
+ * penumbra is wrong by design: measured, and bounded from below so that a
+ * change that made it PCSS would be noticed. */
+TEST(test_filtered_soft_dpcf_on_parallel_planes)
+{
+    Lab *lab = square_light_strip();
+    CHECK(lab);
+    const char *p[] = {"map_size=256", NULL};
+    StripRun s;
+    CHECK(strip_run(lab, "dpcf", p, &s));
+    printf("    dpcf: max |e| against the exact convolution %.4f over %d penumbra samples; Embree penumbra RMSE %.4f "
+           "(noise %.4f)\n",
+           s.max_exact, s.penumbra, s.penumbra_rmse, s.noise);
+    CHECK(s.penumbra > 500);
+    CHECK_MSG(s.penumbra_rmse <= DPCF_STRIP_RMSE, "penumbra RMSE %.4f above %.3f", s.penumbra_rmse, DPCF_STRIP_RMSE);
+    CHECK_MSG(s.max_exact > 0.5 / s.window + 0.004, "dpcf met the box bound (max |e| %.4f)", s.max_exact);
+    lab_close(lab);
+}
+
+/* Occluder fusion on overlap.lua (course Figs. 1.7, 5.19; §5.2.2.1 issues
+ * 1-2) under a 0.9 x 0.9 rect light: where the high slab and the low slab
+ * share the search window one average depth stands for both, and the map
+ * holds only the high slab where they overlap. Signed error measured per
+ * region; the strip's bound is broken on a share of the penumbra. */
+TEST(test_filtered_soft_overlap_fusion_breaks_the_strip_bound)
+{
+    const char *light[] = {"lights[1]={type='rect', position={-1.0, 5.0, -1.5}, direction={0, -1, 0}, up={0, 0, -1}, "
+                           "width=0.9, height=0.9}",
+                           NULL};
+    Lab *lab = soft_open("overlap.lua", light);
+    CHECK(lab);
+    static const char *const techs[] = {"pcss", "pcss_prefiltered", "cssm", "evssm", "dpcf"};
+    for (size_t k = 0; k < sizeof techs / sizeof techs[0]; k++) {
+        const char *p[] = {"map_size=512", k == 0 ? "sampling=exhaustive" : NULL, NULL};
+        RenderResult r;
+        Metrics m;
+        Image e;
+        CHECK(soft_render(lab, techs[k], p, &r));
+        CHECK(signed_error(lab, &r.visibility, REF_SAMPLES, &m, &e));
+        double bound = FUSION_BOUND + 4.0 * m.region[REGION_PENUMBRA].noise_rms;
+        long over = signed_error_count(&e, -bound, bound), pen = m.region[REGION_PENUMBRA].count;
+        const ErrorStats *pe = &m.region[REGION_PENUMBRA], *um = &m.region[REGION_UMBRA];
+        printf("    %-16s penumbra RMSE %.4f signed %+.4f (leak %.4f, dark %.4f); umbra signed %+.4f; |e| > %.3f: %ld "
+               "samples (penumbra %ld)\n",
+               techs[k], pe->rmse, pe->mean_signed, pe->leak_mean, pe->dark_mean, um->mean_signed, bound, over, pen);
+        CHECK(m.nonfinite == 0 && outside_unit_range(&r.visibility) == 0);
+        CHECK_MSG(over > pen / 50, "%s: only %ld samples break the bound", techs[k], over);
+        image_free(&e);
+        render_result_free(&r);
+    }
+    lab_close(lab);
+}
+
+/* NaN never becomes "lit": Yang's blocker mean carries a NaN estimate on
+ * (the techniques then return NaN, counted non-finite), and only a blocked
+ * fraction below the threshold calls the receiver lit. */
+TEST(test_filtered_soft_blocker_mean_carries_nan)
+{
+    double z = 0.0;
+    CHECK(filtsoft_blocker_mean(0.5, NAN, 0.8, 1e-4, &z) && z != z);
+    CHECK(filtsoft_blocker_mean(NAN, 0.5, 0.8, 1e-4, &z) && z != z);
+    CHECK(!filtsoft_blocker_mean(0.8, 1.0, 0.8, 1e-4, &z));
+    CHECK(filtsoft_blocker_mean(0.5, 0.5, 0.8, 1e-4, &z) && fabs(z - 0.2) < 1e-12); /* 0.5 = 0.5 0.8 + 0.5 z */
+}
