@@ -297,24 +297,28 @@ static bool poly_unknown(const Poly *p, bool rect)
 }
 
 /* 1 - occluded share of the light's samples over the window; NaN when an
- * occluder that may exist reads a NaN depth (issue 13 §1). */
+ * occluder that may exist reads a NaN depth (issue 13 §1), unless the known
+ * ones already cover every sample (occluders only add: V = 0 either way). */
 static double window_visibility(const BpState *st, const FaceSamples *fs, const Window *w)
 {
     uint64_t mask[BP_WORDS] = {0};
     long sum = 0;
-    bool patch = st->occluder == OCC_MICROPATCH;
+    bool patch = st->occluder == OCC_MICROPATCH, unknown = false;
     for (int b = patch ? 1 : 0; b < w->h - 1; b++)
         for (int a = patch ? 1 : 0; a < w->w - 1; a++) {
             Poly p = {.n = 0};
             bool ok = patch ? win_z(w, a, b) != INFINITY && micropatch(st, w, a, b, &p) : microquad(st, w, a, b, &p);
             if (!ok) continue;
-            if (poly_unknown(&p, patch)) return NAN;
+            if (poly_unknown(&p, patch)) {
+                unknown = true;
+                continue;
+            }
             sum += cover(fs, &p, patch, st->accumulate == ACC_AREA ? NULL : mask); /* area: counted, not united */
         }
-    if (st->accumulate == ACC_AREA) return sum >= st->samples ? 0.0 : 1.0 - (double)sum / st->samples;
+    if (st->accumulate == ACC_AREA) return sum >= st->samples ? 0.0 : unknown ? NAN : 1.0 - (double)sum / st->samples;
     int marked = 0;
     for (int k = 0; k < BP_WORDS; k++) marked += __builtin_popcountll(mask[k]);
-    return 1.0 - (double)marked / st->samples;
+    return marked == st->samples ? 0.0 : unknown ? NAN : 1.0 - (double)marked / st->samples;
 }
 
 static float visibility(const BpState *st, const SmapReceiver *r, Window *w, int *level)

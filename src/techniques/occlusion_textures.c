@@ -185,7 +185,8 @@ static void window(double c, double half_texels, int *lo, int *hi)
 }
 
 /* Product over the slices wholly in front of the receiver's biased depth;
- * NaN when that depth is NaN or a window holds a NaN texel (issue 13 §1). */
+ * NaN when that depth is NaN or a window holds a NaN texel (issue 13 §1),
+ * unless the known casters already make it 0 (a caster only lowers it). */
 static float visibility(const OtState *st, const SmapReceiver *r)
 {
     int face = r->mc.face, i, j;
@@ -195,16 +196,17 @@ static float visibility(const OtState *st, const SmapReceiver *r)
     double p_z = smap_linear_depth(st->sm.map, face, smap_ref_at(r, i, j)), r_z = r->mc.depth_linear;
     if (isnan(p_z)) return NAN; /* which slices lie in front is unknown */
     double v = 1.0;
+    bool unknown = false;
     for (int k = 0; k < st->slices; k++) {
         double bottom = f->z0 + (k + 1) * f->thick; /* the plane the slice is projected onto */
         if (!(bottom < p_z)) break;                 /* NaN: no slice known to lie in front */
         int i0, i1, j0, j1;
         window(r->mc.s, backproject_footprint(sf->light.half_x, r_z, bottom) / sf->dx, &i0, &i1);
         window(r->mc.t, backproject_footprint(sf->light.half_y, r_z, bottom) / sf->dy, &j0, &j1);
-        if (box_mean(st, face, st->slices, i0, j0, i1, j1) > 0.0) return NAN; /* a caster of unknown slice */
+        unknown = unknown || box_mean(st, face, st->slices, i0, j0, i1, j1) > 0.0; /* a caster of unknown slice */
         v *= 1.0 - box_mean(st, face, k, i0, j0, i1, j1);
     }
-    return (float)v;
+    return unknown && v > 0.0 ? NAN : (float)v;
 }
 
 static void ot_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
