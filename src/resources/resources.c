@@ -47,6 +47,8 @@ struct ResourceManager {
     double budget_s; /* > 0: and no more once they took this long */
     double scope_build_s;
     EventList scope;
+    ResourceBuiltFn on_build; /* rm_on_build */
+    void *on_build_user;
 };
 
 const char *resource_category_name(ResourceCategory c)
@@ -260,10 +262,17 @@ void *rm_acquire(ResourceManager *rm, const ResourceKind *kind, uint64_t key, co
     bool built = i < 0;
     ResourceCategory category = category_in(current_context(rm), kind);
     if (built && (i = build_entry(rm, kind, key, desc, build, args, err)) < 0) return NULL;
+    if (built && rm->on_build) rm->on_build(kind->name, rm->entries[i].res, rm->on_build_user);
     event_add(&rm->log, &rm->entries[i], desc, built, category);
     if (rm->depth > 0) int_list_add_unique(&rm->frames[rm->depth - 1].deps, i);
     if (rm->scoping) scope_add(rm, i, built, category);
     return rm->entries[i].res;
+}
+
+void rm_on_build(ResourceManager *rm, ResourceBuiltFn fn, void *user)
+{
+    rm->on_build = fn;
+    rm->on_build_user = user;
 }
 
 int rm_log_count(const ResourceManager *rm) { return rm->log.n; }

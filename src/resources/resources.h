@@ -64,6 +64,14 @@ void rm_clear(ResourceManager *rm);
 void *rm_acquire(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc,
                  ResourceBuildFn build, const void *args, Error *err);
 
+/* Instrumentation: fn sees every resource the manager builds, with its
+ * kind's name, as soon as it is built and before anything acquires it
+ * (NULL: none). Fault-injection tests use it (test_nan_inject.c poisons
+ * every shadow map, whatever key a technique asks for, before anything
+ * derived from it is built). */
+typedef void (*ResourceBuiltFn)(const char *kind, void *res, void *user);
+void rm_on_build(ResourceManager *rm, ResourceBuiltFn fn, void *user);
+
 /* The log since the last rm_log_reset (one run's worth). */
 int rm_log_count(const ResourceManager *rm);
 const ResourceEvent *rm_log_event(const ResourceManager *rm, int i);

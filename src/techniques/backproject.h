@@ -117,7 +117,7 @@ static inline bool backproject_search(const SoftMap *sm, const SmapReceiver *r, 
         backproject_search_halfwidth(sm, r, *z_b, &wi, &wj);
         double z_min;
         if (!softmap_may_block(sm, r, i - wi, j - wj, i + wi, j + wj, &z_min)) return false;
-        if (z_min > *z_b) *z_b = z_min;
+        if (z_min > *z_b) *z_b = z_min; /* NaN: not narrowed, the wider area keeps every blocker (issue 13 §1) */
     }
     return true;
 }

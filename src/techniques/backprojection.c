@@ -28,6 +28,7 @@
  * Only casters seen from the light's centre exist (one layer; course
  * Fig. 1.8). The light is the scene's (sphere: its central cross-section). */
 #include <stdlib.h>
+#include "core/nanmath.h"
 #include "techniques/backproject.h"
 
 enum { OCC_MICROPATCH, OCC_MICROQUAD, OCC_MICROTRI };
@@ -145,8 +146,9 @@ static bool bp_prepare(const TechContext *ctx, void **state, Error *err)
 
 /* The occluder samples of one receiver: the search window at one pyramid
  * level, with a border of one lexel (gap filling and quads read their
- * neighbours), each lexel's caster depth (world units) or +INFINITY where
- * its closest texel does not lie in front of p. */
+ * neighbours), each lexel's caster depth (world units), +INFINITY where
+ * its closest texel does not lie in front of p, NaN where the test reads a
+ * NaN (an unknown caster, issue 13 §1). */
 typedef struct Window {
     int level, i0, j0, w, h; /* first lexel (border included) and size */
     double dx, dy;           /* lexel size, tangent units */
@@ -188,10 +190,9 @@ static void load_window(const BpState *st, const SmapReceiver *r, int wi, int wj
     for (int b = 0; b < w->h; b++)
         for (int a = 0; a < w->w; a++) {
             int ti = w->i0 + a, tj = w->j0 + b; /* off the face: edge-clamped, as every window of the map */
-            w->z[b][a] = INFINITY;
-            float stored = minmax_node_min(st->sm.pyramid, r->mc.face, level, &ti, &tj);
-            if (smap_ref_at(r, ti, tj) > stored) /* NaN: not a caster */
-                w->z[b][a] = smap_linear_depth(st->sm.map, r->mc.face, stored);
+            float stored = minmax_node_min(st->sm.pyramid, r->mc.face, level, &ti, &tj); /* keeps NaN */
+            float lit = smap_test(smap_ref_at(r, ti, tj), stored);
+            w->z[b][a] = lit == 0.0f ? smap_linear_depth(st->sm.map, r->mc.face, stored) : lit == 1.0f ? INFINITY : NAN;
         }
 }
 
@@ -242,11 +243,13 @@ static int cover(const FaceSamples *fs, const Poly *p, bool rect, uint64_t *mask
 static double win_x(const Window *w, double a) { return w->l + (w->i0 + a) * w->dx; }
 static double win_y(const Window *w, double b) { return w->b + (w->j0 + b) * w->dy; }
 
-/* The point at tangents (x, y), depth z, projected from p onto the light's plane. */
+/* The point at tangents (x, y), depth z, projected from p onto the light's
+ * plane; an unknown caster (z NaN) has an unknown image (NaN), so the
+ * polygon it is part of is unknown (issue 13 §1). */
 static bool project(const Window *w, double x, double y, double z, double *lx, double *ly)
 {
-    double k;
-    if (!backproject_light_scale(w->p_z, z, &k)) return false;
+    double k = NAN;
+    if (!isnan(z) && !backproject_light_scale(w->p_z, z, &k)) return false;
     *lx = k * (x - w->u);
     *ly = k * (y - w->v);
     return true;
@@ -262,11 +265,12 @@ static bool micropatch(const BpState *st, const Window *w, int a, int b, Poly *p
     if (!project(w, x0, y0, z, &p->x[0], &p->y[0]) || !project(w, x1, y1, z, &p->x[1], &p->y[1])) return false;
     if (st->gaps == GAPS_NONE) return true;
     double lx, ly;
-    if (project(w, x0, y0, win_z(w, a - 1, b), &lx, &ly)) p->x[0] = fmin(p->x[0], lx); /* left neighbour's x1 edge */
-    if (project(w, x0, y0, win_z(w, a, b - 1), &lx, &ly)) p->y[0] = fmin(p->y[0], ly); /* bottom neighbour's y1 */
+    /* nan_min: a neighbour of unknown depth leaves the edge unknown */
+    if (project(w, x0, y0, win_z(w, a - 1, b), &lx, &ly)) p->x[0] = nan_min(p->x[0], lx); /* left's x1 edge */
+    if (project(w, x0, y0, win_z(w, a, b - 1), &lx, &ly)) p->y[0] = nan_min(p->y[0], ly); /* bottom's y1 */
     if (st->gaps == GAPS_DIAGONAL && project(w, x0, y0, win_z(w, a - 1, b - 1), &lx, &ly)) {
-        p->x[0] = fmin(p->x[0], lx);
-        p->y[0] = fmin(p->y[0], ly);
+        p->x[0] = nan_min(p->x[0], lx);
+        p->y[0] = nan_min(p->y[0], ly);
     }
     return true;
 }
@@ -284,23 +288,37 @@ static bool microquad(const BpState *st, const Window *w, int a, int b, Poly *p)
     return p->n == 4 || (st->occluder == OCC_MICROTRI && p->n == 3);
 }
 
-/* 1 - occluded share of the light's samples over the window. */
+/* Does a vertex of the polygon (rect: its two corners) lie at an unknown place? */
+static bool poly_unknown(const Poly *p, bool rect)
+{
+    for (int k = 0; k < (rect ? 2 : p->n); k++)
+        if (isnan(p->x[k]) || isnan(p->y[k])) return true;
+    return false;
+}
+
+/* 1 - occluded share of the light's samples over the window; NaN when an
+ * occluder that may exist reads a NaN depth (issue 13 §1), unless the known
+ * ones already cover every sample (occluders only add: V = 0 either way). */
 static double window_visibility(const BpState *st, const FaceSamples *fs, const Window *w)
 {
     uint64_t mask[BP_WORDS] = {0};
     long sum = 0;
-    bool patch = st->occluder == OCC_MICROPATCH;
+    bool patch = st->occluder == OCC_MICROPATCH, unknown = false;
     for (int b = patch ? 1 : 0; b < w->h - 1; b++)
         for (int a = patch ? 1 : 0; a < w->w - 1; a++) {
             Poly p = {.n = 0};
-            bool ok = patch ? isfinite(win_z(w, a, b)) && micropatch(st, w, a, b, &p) : microquad(st, w, a, b, &p);
+            bool ok = patch ? win_z(w, a, b) != INFINITY && micropatch(st, w, a, b, &p) : microquad(st, w, a, b, &p);
             if (!ok) continue;
+            if (poly_unknown(&p, patch)) {
+                unknown = true;
+                continue;
+            }
             sum += cover(fs, &p, patch, st->accumulate == ACC_AREA ? NULL : mask); /* area: counted, not united */
         }
-    if (st->accumulate == ACC_AREA) return sum >= st->samples ? 0.0 : 1.0 - (double)sum / st->samples;
+    if (st->accumulate == ACC_AREA) return sum >= st->samples ? 0.0 : unknown ? NAN : 1.0 - (double)sum / st->samples;
     int marked = 0;
     for (int k = 0; k < BP_WORDS; k++) marked += __builtin_popcountll(mask[k]);
-    return 1.0 - (double)marked / st->samples;
+    return marked == st->samples ? 0.0 : unknown ? NAN : 1.0 - (double)marked / st->samples;
 }
 
 static float visibility(const BpState *st, const SmapReceiver *r, Window *w, int *level)

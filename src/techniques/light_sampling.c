@@ -127,23 +127,27 @@ static bool ls_prepare(const TechContext *ctx, void **state, Error *err)
 }
 
 /* The lit fraction of the samples above the tangent plane (all of them
- * when none is: a terminator sliver the N points miss). */
+ * when none is: a terminator sliver the N points miss). A depth test that
+ * reads a NaN (smap_lit: neither lit nor shadowed) in the fraction makes it
+ * NaN: the sums carry it (issue 13 §1; `lit > 0.5` read it as shadowed). */
 static float visibility(const LsState *st, vec3 p, vec3 n)
 {
-    int above = 0, lit_above = 0, lit_all = 0;
+    int above = 0;
+    float lit_above = 0.0f, lit_all = 0.0f;
     for (int k = 0; k < st->n; k++) {
         SmapReceiver r;
-        int i, j, lit = 1; /* outside the map nothing is known to block: lit */
+        int i, j;
+        float lit = 1.0f; /* outside the map nothing is known to block: lit */
         if (smap_receiver(st->map[k], &st->bias, p, n, &r)) {
             smap_texel(&r, &i, &j);
-            lit = smap_lit(st->map[k], &r, i, j) > 0.5f;
+            lit = smap_lit(st->map[k], &r, i, j); /* 0, 1 or NaN */
         }
         bool up = v3_dot(n, v3_sub(st->point[k], p)) > 0.0f;
         above += up;
-        lit_above += up && lit;
+        lit_above += up ? lit : 0.0f;
         lit_all += lit;
     }
-    return above ? (float)lit_above / above : (float)lit_all / st->n;
+    return above ? lit_above / above : lit_all / st->n;
 }
 
 static void ls_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)

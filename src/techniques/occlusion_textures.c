@@ -19,7 +19,13 @@
  * slice correctly), the receiver's own slice casts nothing (no intra-slice
  * shadows: contact accuracy is one slice thick), and the textures come from
  * the map's first layer (an occluder hidden from the light's centre is in
- * no slice; the paper renders each slice's geometry). */
+ * no slice; the paper renders each slice's geometry).
+ *
+ * A NaN depth (issue 13 §1) is a caster of unknown slice, or none: one more
+ * table per face counts such texels, and a receiver whose window in a slice
+ * in front holds one is NaN (the counts are integers: no NaN spreads to the
+ * windows after it, as it would through a float SAT). The slices' depth
+ * range is the finite depths'. */
 #include <stdlib.h>
 #include "techniques/backproject.h"
 
@@ -32,7 +38,7 @@ static const ParamDesc ot_params[] = {
     SMAP_BIAS_PARAMS,
     {"slices", PARAM_INT, 8, 1, OT_MAX_SLICES, "slices",
      "S: slices of each face's caster depth range, uniform in depth (course §5.2.5: \"between 4 and 16\"); "
-     "memory S x (map_size + 1)^2 x 4 bytes per face",
+     "memory (S + 1) x (map_size + 1)^2 x 4 bytes per face (one more table counts NaN texels)",
      NULL},
 };
 
@@ -47,12 +53,13 @@ typedef struct OtState {
     SmapBias bias;
     int slices, stride;  /* stride = map_size + 1: a SAT row */
     OtFace face[LIGHTVIEW_MAX_FACES];
-    uint32_t *sat;       /* [(face * slices + k) * stride^2 + j * stride + i]: occupied texels of slice k below (i, j) */
+    uint32_t *sat;       /* [(face * (slices + 1) + k) * stride^2 + j * stride + i]: occupied texels of slice k
+                          * below (i, j); table k = slices counts the NaN texels */
 } OtState;
 
 static uint32_t *sat_of(const OtState *st, int face, int k)
 {
-    return st->sat + ((size_t)face * st->slices + k) * (size_t)st->stride * st->stride;
+    return st->sat + ((size_t)face * (st->slices + 1) + k) * (size_t)st->stride * st->stride;
 }
 
 /* The depth range of a face's casters (world units), [+INF, -INF] when empty. */
@@ -78,7 +85,7 @@ static int slice_of(const OtFace *f, int slices, double d)
     return k >= 0.0 ? (int)fmin(k, slices - 1) : 0;
 }
 
-/* Slice k's SAT from each texel's slice (OT_EMPTY: no caster), one pass per slice. */
+/* Slice k's SAT from each texel's slice (OT_EMPTY: no caster; slices: NaN), one pass per table. */
 #define OT_EMPTY 255
 static bool build_face(OtState *st, int face)
 {
@@ -93,9 +100,10 @@ static bool build_face(OtState *st, int face)
     for (int j = 0; j < res; j++)
         for (int i = 0; i < res; i++) {
             double d = softmap_depth(&st->sm, face, i, j);
-            slice[(size_t)j * res + i] = isfinite(d) ? (uint8_t)slice_of(f, st->slices, d) : OT_EMPTY;
+            slice[(size_t)j * res + i] =
+                isnan(d) ? (uint8_t)st->slices : isfinite(d) ? (uint8_t)slice_of(f, st->slices, d) : OT_EMPTY;
         }
-    for (int k = 0; k < st->slices; k++) {
+    for (int k = 0; k <= st->slices; k++) {
         uint32_t *sat = sat_of(st, face, k);
         for (int j = 0; j < res; j++) {
             uint32_t row = 0;
@@ -130,7 +138,7 @@ static bool ot_prepare(const TechContext *ctx, void **state, Error *err)
     st->bias = smap_bias(p, ctx->scene);
     st->slices = (int)p[P_SLICES];
     st->stride = map->res + 1;
-    size_t entries = (size_t)map->num_faces * st->slices * st->stride * st->stride;
+    size_t entries = (size_t)map->num_faces * (st->slices + 1) * st->stride * st->stride;
     double gib = (double)entries * sizeof(uint32_t) / (1u << 30);
     if (entries * sizeof(uint32_t) > SHADOWMAP_MAX_BYTES) {
         free(st);
@@ -176,7 +184,9 @@ static void window(double c, double half_texels, int *lo, int *hi)
     *hi = *lo + K - 1;
 }
 
-/* Product over the slices wholly in front of the receiver's biased depth. */
+/* Product over the slices wholly in front of the receiver's biased depth;
+ * NaN when that depth is NaN or a window holds a NaN texel (issue 13 §1),
+ * unless the known casters already make it 0 (a caster only lowers it). */
 static float visibility(const OtState *st, const SmapReceiver *r)
 {
     int face = r->mc.face, i, j;
@@ -184,16 +194,19 @@ static float visibility(const OtState *st, const SmapReceiver *r)
     const SoftFace *sf = &st->sm.face[face];
     smap_texel(r, &i, &j);
     double p_z = smap_linear_depth(st->sm.map, face, smap_ref_at(r, i, j)), r_z = r->mc.depth_linear;
+    if (isnan(p_z)) return NAN; /* which slices lie in front is unknown */
     double v = 1.0;
+    bool unknown = false;
     for (int k = 0; k < st->slices; k++) {
         double bottom = f->z0 + (k + 1) * f->thick; /* the plane the slice is projected onto */
         if (!(bottom < p_z)) break;                 /* NaN: no slice known to lie in front */
         int i0, i1, j0, j1;
         window(r->mc.s, backproject_footprint(sf->light.half_x, r_z, bottom) / sf->dx, &i0, &i1);
         window(r->mc.t, backproject_footprint(sf->light.half_y, r_z, bottom) / sf->dy, &j0, &j1);
+        unknown = unknown || box_mean(st, face, st->slices, i0, j0, i1, j1) > 0.0; /* a caster of unknown slice */
         v *= 1.0 - box_mean(st, face, k, i0, j0, i1, j1);
     }
-    return (float)v;
+    return unknown && v > 0.0 ? NAN : (float)v;
 }
 
 static void ot_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)

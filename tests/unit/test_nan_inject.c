@@ -1,9 +1,12 @@
 /* test_nan_inject.c -- a NaN depth reaches the output as NaN (issue 13 §1):
- * for every shadow-map technique, the depth map its default parameters ask
- * for is acquired first and every other texel (a checkerboard) set to NaN,
- * so every resource built from it (moments, box blurs, SATs, min-max
- * pyramids, shadow-width maps) inherits the NaN and every filter window
- * mixes NaN with depths (where fmin/fmax would keep the depths); then the
+ * for every shadow-map technique, every shadow map the lab builds gets a
+ * NaN checkerboard (every other texel) as soon as it is built, through the
+ * resource manager's build hook, before anything reads it: the maps a
+ * technique keys its own way (light_sampling's, one per light sample, keyed
+ * by the sample point) are poisoned like the light's own, and every
+ * resource built from a map (moments, box blurs, SATs, min-max pyramids,
+ * shadow-width maps, slice tables) inherits the NaN, so every filter window
+ * mixes NaN with depths (where fmin/fmax would keep the depths). Then the
  * technique renders, and samples that read a NaN texel must be NaN in the
  * visibility (the test asks for some: nearest lookups read half), and
  * the metrics must count them as non-finite, not score them as lit or
@@ -23,8 +26,19 @@
 #define NAN_H 36
 #define NAN_MAP_SIZE 64
 
-/* Render t on a lab whose depth map is a NaN checkerboard; the lit candidates and
- * the NaN among them; metrics' non-finite count. false if it cannot run. */
+/* rm_on_build hook: a NaN checkerboard over every face of a shadow map. */
+static void poison_map(const char *kind, void *res, void *user)
+{
+    (void)user;
+    if (strcmp(kind, "shadow_map") != 0) return;
+    ShadowMap *m = res;
+    for (size_t i = 0; i < (size_t)m->num_faces * m->res * m->res; i++)
+        if ((i % (size_t)m->res + i / (size_t)m->res) % 2 == 0) m->depth[i] = NAN;
+}
+
+/* Render t on a lab whose every depth map is a NaN checkerboard; the lit
+ * candidates and the NaN among them; metrics' non-finite count. false if it
+ * cannot run. */
 static bool render_poisoned(const Technique *t, const char *scene, long *candidates, long *nans, long *nonfinite)
 {
     Error err;
@@ -33,14 +47,10 @@ static bool render_poisoned(const Technique *t, const char *scene, long *candida
     double p[TECH_MAX_PARAMS];
     tech_params_default(t, p);
     p[SMAP_P_MAP_SIZE] = NAN_MAP_SIZE;
-    ShadowMapSpec spec = smap_spec(p);
-    ShadowMap *m = (ShadowMap *)res_shadow_map(lab_resources(lab), lab_scene(lab), 0, &spec, &err);
+    rm_on_build(lab_resources(lab), poison_map, NULL);
     RenderRequest rq = {.tech = t, .params = p, .light_index = 0, .repeat = 1};
     RenderResult r;
-    bool ok = m != NULL;
-    for (size_t i = 0; ok && i < (size_t)m->num_faces * m->res * m->res; i++)
-        if ((i % (size_t)m->res + i / (size_t)m->res) % 2 == 0) m->depth[i] = NAN; /* a checkerboard */
-    ok = ok && lab_render(lab, &rq, &r, &err);
+    bool ok = lab_render(lab, &rq, &r, &err);
     if (!ok) printf("    %s: %s\n", t->name, err.msg);
     const uint8_t *cls = ok ? res_classes(lab_resources(lab), lab_scene(lab), 0, &err) : NULL;
     *candidates = *nans = 0;
