@@ -372,7 +372,10 @@ TEST(test_occlusion_textures_exact_for_parallel_planes_and_leaky_fusion)
            pe->count, pe->rmse, bound, pe->noise_rms, m.region[REGION_UMBRA].mae, m.region[REGION_LIT].mae);
     CHECK(pe->count > 300);
     CHECK_MSG(pe->rmse <= bound + pe->noise_rms, "penumbra RMSE %.4f above %.4f", pe->rmse, bound + pe->noise_rms);
-    CHECK(m.region[REGION_UMBRA].mae < 0.01 && m.region[REGION_LIT].mae < 0.01);
+    /* No umbra sample: from this camera the strip (not a receiver) hides the
+     * ground under it (an empty region is absent, count 0); the lit side is exact. */
+    CHECK(m.region[REGION_UMBRA].count == 0 || m.region[REGION_UMBRA].mae < 0.01);
+    CHECK(m.region[REGION_LIT].mae < 0.01);
     render_result_free(&r);
     lab_close(lab);
 
