@@ -82,8 +82,7 @@ static void technique_table(FILE *fp)
     }
 }
 
-/* How technique t's parameter k differs from the base's ("" when it does not). */
-static void difference(const Technique *base_t, const Technique *t, int k, char *out, size_t n)
+void docgen_param_difference(const Technique *base_t, const Technique *t, int k, char *out, size_t n)
 {
     const ParamDesc *base = &base_t->params[k], *p = &t->params[k];
     char def[64], range[256];
@@ -108,11 +107,11 @@ static void differences(const Technique *const *maps, int n, int k, char *out, s
     bool listed[64] = {false};
     for (int i = 1; i < n && used < size; i++) {
         char what[320], other[320];
-        difference(maps[0], maps[i], k, what, sizeof what);
+        docgen_param_difference(maps[0], maps[i], k, what, sizeof what);
         if (!what[0] || listed[i]) continue;
         used += (size_t)snprintf(out + used, size - used, "%s%s in `%s`", used ? "; " : "", what, maps[i]->name);
         for (int j = i + 1; j < n && used < size; j++) {
-            difference(maps[0], maps[j], k, other, sizeof other);
+            docgen_param_difference(maps[0], maps[j], k, other, sizeof other);
             if (strcmp(other, what) != 0) continue;
             listed[j] = true;
             used += (size_t)snprintf(out + used, size - used, ", `%s`", maps[j]->name);
@@ -125,7 +124,7 @@ static void differences(const Technique *const *maps, int n, int k, char *out, s
  * share, in order (SMAP_MAP_PARAMS, SMAP_BIAS_PARAMS). */
 static int shared_count(const Technique *const *maps, int n)
 {
-    int shared = maps[0]->num_params;
+    int shared = n > 0 ? maps[0]->num_params : 0;
     for (int i = 1; i < n; i++) {
         int k = 0;
         while (k < shared && k < maps[i]->num_params && strcmp(maps[i]->params[k].name, maps[0]->params[k].name) == 0)
@@ -135,18 +134,25 @@ static int shared_count(const Technique *const *maps, int n)
     return shared;
 }
 
+int docgen_map_techniques(const Technique **maps, int max, int *shared)
+{
+    int n = 0;
+    for (int i = 0; i < tech_count() && n < max; i++)
+        if (smap_has_map_params(tech_at(i))) maps[n++] = tech_at(i);
+    *shared = shared_count(maps, n);
+    return n;
+}
+
 static void shared_map_params(FILE *fp)
 {
     const Technique *maps[64];
-    int n = 0;
-    for (int i = 0; i < tech_count() && n < 64; i++)
-        if (smap_has_map_params(tech_at(i))) maps[n++] = tech_at(i);
+    int shared, n = docgen_map_techniques(maps, 64, &shared);
     if (n == 0) return;
     fprintf(fp, "\nEvery shadow-map technique (");
     for (int i = 0; i < n; i++) fprintf(fp, "%s`%s`", i ? ", " : "", maps[i]->name);
     fprintf(fp, ") takes these shared map parameters first; its own follow them in `docs/techniques.md` "
                 "and `shadowlab list`.\n\n%s", param_header);
-    for (int k = 0; k < shared_count(maps, n); k++) {
+    for (int k = 0; k < shared; k++) {
         char note[1024];
         differences(maps, n, k, note, sizeof note);
         param_row(fp, &maps[0]->params[k], tech_param_when(maps[0], k), note);

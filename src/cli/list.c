@@ -5,29 +5,63 @@
 #include "cli/cli.h"
 #include "cli/docgen.h"
 #include "core/json.h"
+#include "techniques/smap.h"
 
-static void print_text(void)
+static void print_param(const Technique *t, int k)
 {
+    const ParamDesc *p = &t->params[k];
+    const char *when = tech_param_when(t, k);
+    char def[64], range[256];
+    tech_param_format(p, p->def, def, sizeof def);
+    tech_param_range(p, range, sizeof range);
+    printf("  -p %s=%s  (%s %s%s%s)\n      %s\n", p->name, def, param_type_name(p->type), range, p->unit[0] ? ", " : "",
+           p->unit, p->doc);
+    if (when) printf("      acts only when %s\n", when);
+}
+
+static void print_header(const Technique *t)
+{
+    char lights[160];
+    tech_lights_text(t, lights, sizeof lights);
+    printf("%s  [%s; %s]\n  %s\n  lights: %s\n  main parameter: %s\n", t->name, t->family, t->source, t->summary,
+           lights, t->main_param ? t->main_param : "none");
+    printf("  resources:");
+    for (const char *const *r = t->resources; *r; r++) printf(" %s", *r);
+    printf("\n");
+}
+
+/* One technique with every parameter it offers (`list TECH`). */
+static void print_one(const Technique *t)
+{
+    print_header(t);
+    for (int k = 0; k < t->num_params; k++)
+        if (tech_param_offered(t, k)) print_param(t, k);
+}
+
+/* Every technique: the shared map and bias parameters once, then each
+ * technique's own, with where its declaration of a shared one differs. */
+static void print_all(void)
+{
+    const Technique *maps[64];
+    int shared, n = docgen_map_techniques(maps, 64, &shared);
+    if (n > 0) {
+        printf("shared shadow-map parameters, taken first by every map technique (marked [map] below; where one "
+               "differs it says so; `shadowlab list TECH` shows one technique whole):\n");
+        for (int k = 0; k < shared; k++) print_param(maps[0], k);
+        printf("\n");
+    }
     for (int i = 0; i < tech_count(); i++) {
         const Technique *t = tech_at(i);
-        char lights[160];
-        tech_lights_text(t, lights, sizeof lights);
-        printf("%s  [%s; %s]\n  %s\n  lights: %s\n  main parameter: %s\n", t->name, t->family, t->source, t->summary,
-               lights, t->main_param ? t->main_param : "none");
-        printf("  resources:");
-        for (const char *const *r = t->resources; *r; r++) printf(" %s", *r);
-        printf("\n");
-        for (int k = 0; k < t->num_params; k++) {
-            const ParamDesc *p = &t->params[k];
-            const char *when = tech_param_when(t, k);
-            char def[64], range[256];
-            if (!tech_param_offered(t, k)) continue;
-            tech_param_format(p, p->def, def, sizeof def);
-            tech_param_range(p, range, sizeof range);
-            printf("  -p %s=%s  (%s %s%s%s)\n      %s\n", p->name, def, param_type_name(p->type), range,
-                   p->unit[0] ? ", " : "", p->unit, p->doc);
-            if (when) printf("      acts only when %s\n", when);
+        bool map = n > 0 && smap_has_map_params(t);
+        print_header(t);
+        if (map) printf("  [map] the shared parameters above\n");
+        for (int k = 0; map && k < shared; k++) {
+            char what[320];
+            docgen_param_difference(maps[0], t, k, what, sizeof what);
+            if (what[0]) printf("  -p %s: %s here\n", t->params[k].name, what);
         }
+        for (int k = map ? shared : 0; k < t->num_params; k++)
+            if (tech_param_offered(t, k)) print_param(t, k);
         printf("\n");
     }
 }
@@ -82,17 +116,27 @@ static void print_json(void)
 
 static const CliAccept list_options[] = {
     {OPT_JSON, NULL}, {OPT_MARKDOWN, NULL}, {OPT_README, NULL}, {OPT_NAMES, NULL}, {OPT_END, NULL}};
-static const CliCommand list_cmd = {"list", "[--json | --markdown | --readme | --names]", false, list_options,
+static const CliCommand list_cmd = {"list", "[TECH] [--json | --markdown | --readme | --names]", false, list_options,
                                     "every technique of the registry with its parameters: type, default, range, "
-                                    "unit, doc\n"};
+                                    "unit, doc (the shared map parameters once); TECH: that technique whole\n"};
 
 int cmd_list(int argc, char **argv)
 {
     CliOptions o;
     Error err;
-    bool ok = cli_parse(&list_cmd, argc, argv, &o, &err);
+    const Technique *one = NULL;
+    bool ok = true;
+    if (argc > 1 && argv[1][0] != '-') { /* list TECH */
+        one = tech_find(argv[1], &err);
+        ok = one != NULL;
+        argv[1] = argv[0];
+        argc--, argv++;
+    }
+    ok = ok && cli_parse(&list_cmd, argc, argv, &o, &err);
     if (ok && o.json + o.markdown + o.readme + o.names > 1)
         ok = error_set(&err, "--json, --markdown, --readme and --names are exclusive: give one");
+    if (ok && one && o.json + o.markdown + o.readme + o.names > 0)
+        ok = error_set(&err, "list TECH prints one technique as text: no --json, --markdown, --readme or --names");
     if (!ok) {
         fprintf(stderr, "shadowlab list: %s\n", err.msg);
         return EXIT_USAGE;
@@ -103,6 +147,7 @@ int cmd_list(int argc, char **argv)
     else if (o.readme) docgen_readme_block(stdout);
     else if (o.names)
         for (int i = 0; i < tech_count(); i++) printf("%s\n", tech_at(i)->name);
-    else print_text();
+    else if (one) print_one(one);
+    else print_all();
     return EXIT_OK;
 }

@@ -119,6 +119,10 @@ done
 expect list_refuses_threads 2 "'--threads' does not apply to \`shadowlab list\`" -- "$SL" list --threads 3
 expect list_refuses_technique 2 "'-t' does not apply" -- "$SL" list -t hard
 expect list_formats_exclusive 2 "exclusive" -- "$SL" list --json --names
+expect list_one_technique 0 "main parameter: filter_taps" "-p map_size=1024" "-p filter_taps=16" -- "$SL" list pcss
+expect list_unknown_technique 2 "unknown technique 'nope'" -- "$SL" list nope
+if [ "$("$SL" list | grep -c '^  -p map_size=')" -eq 1 ]; then ok list_shows_the_shared_parameters_once
+else no list_shows_the_shared_parameters_once "map_size listed $("$SL" list | grep -c '^  -p map_size=') times"; fi
 for opt in "-t hard" "-p K=3" "--repeat 5" "--warmup 1"; do
     expect "reference_refuses_${opt%% *}" 2 "'${opt%% *}' does not apply to \`shadowlab reference\`" -- "$SL" reference "$SCENE" $opt
 done
@@ -220,7 +224,7 @@ case \$cmd in
     reference|compare)
         [ "\${DEMO_FAIL:-}" = "\$*" ] && exit 1
         map=""
-        [ "\$cmd" = compare ] && awk -v t="\$3" '/^[^ ]/ { here = (\$1 == t) } here && /^  -p map_size=/ { f = 1 } END { exit !f }' "$TMP/list.txt" && map="-p map_size=128"
+        [ "\$cmd" = compare ] && awk -v t="\$3" '/^[^ ]/ { here = (\$1 == t) } here && (/^  -p map_size=/ || /^  \\[map\\]/) { f = 1 } END { exit !f }' "$TMP/list.txt" && map="-p map_size=128"
         exec "$SL" "\$cmd" "\$@" -s camera.width=32 -s camera.height=24 -n 16 --no-png \$map ;;
     *) exec "$SL" "\$cmd" "\$@" ;;
 esac
