@@ -73,6 +73,17 @@ static void format_params(const RunReport *r, char *out, size_t n)
     }
 }
 
+/* The scene overrides the run was opened with, "key=value; ..." ("" when none). */
+static void format_overrides(const Lab *lab, char *out, size_t n)
+{
+    const char *const *ov;
+    int count = lab_overrides(lab, &ov);
+    size_t used = 0;
+    out[0] = '\0';
+    for (int i = 0; i < count && used < n; i++)
+        used += (size_t)snprintf(out + used, n - used, "%s%s", i ? "; " : "", ov[i]);
+}
+
 static void format_reference(const RunReport *r, char *out, size_t n)
 {
     const ReferenceParams *p = &r->ref->params;
@@ -119,7 +130,10 @@ bool report_write_exr(const RunReport *r, const char *path, Error *err)
     if (r->ref) format_reference(r, refdesc, sizeof refdesc);
     snprintf(light, sizeof light, "%d (%s)", r->light_index + 1, light_kind_name(sc->lights[r->light_index].kind));
     snprintf(scale, sizeof scale, "%g", r->error_scale);
+    char overrides[1024];
+    format_overrides(r->lab, overrides, sizeof overrides);
     ExrAttr attrs[] = {
+        {"shadowlab.overrides", overrides},
         {"shadowlab.command", r->command},
         {"shadowlab.scene", sc->path},
         {"shadowlab.scene_hash", hash},

@@ -193,7 +193,15 @@ static const LightView *res_light_view(const MapArgs *a, Error *err)
     char desc[160];
     snprintf(desc, sizeof desc, "light %d, %d^2 %s, fit %s", a->light_index + 1, s->res,
              map_projection_name(s->projection), map_fit_name(s->fit));
-    return rm_acquire(a->rm, &kind_light_view, hash_final(&h), desc, build_light_view, &v, err);
+    uint64_t key = hash_final(&h);
+    const LightView *lv = rm_acquire(a->rm, &kind_light_view, key, desc, build_light_view, &v, err);
+    if (lv && s->projection == MAP_PROJ_AUTO) { /* what auto resolved to, in the run's record */
+        char note[64];
+        snprintf(note, sizeof note, "auto = %s, %d face%s", map_projection_name(lv->projection), lv->num_faces,
+                 lv->num_faces == 1 ? "" : "s");
+        rm_log_note(a->rm, kind_light_view.name, key, note);
+    }
+    return lv;
 }
 
 static void *build_map(const void *args, Error *err)
