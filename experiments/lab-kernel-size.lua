@@ -38,7 +38,7 @@ local args = experiment.parse_args(arg, { techniques = { default = "pcf",
   help = "comma-separated techniques with a parameter K to sweep (all: every one)" } })
 local chosen = experiment.technique_set(args.extra.techniques)
 
-local exp = experiment.new{
+local exp = experiment.new{ error = "penumbra.rmse", -- progress lines and plots
   name = "lab-kernel-size", samples = 256, repeats = 3, warmup = 1,
   overrides = { ["camera.width"] = 320, ["camera.height"] = 240, ["objects[2].translate"] = { 0, 0.6, 0 } },
   description = "PCF kernel width K against the reference, for a small and a large spherical light, " ..
@@ -63,4 +63,4 @@ if with_k == 0 then
   error("lab-kernel-size: no chosen technique has a parameter K (pcf should: see `shadowlab list`)", 0)
 end
 if pcall(sl.technique, "sm") then exp:add("sm") end
-report.write(exp:run(args), { title = "Lab: PCF kernel size", error = "penumbra.rmse", questions = QUESTIONS })
+report.write(exp:run(args), { title = "Lab: PCF kernel size", questions = QUESTIONS })

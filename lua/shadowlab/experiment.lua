@@ -30,10 +30,11 @@ Experiment.__index = Experiment
 -- whole sweep so its images compare (0: each image its own, rounded up
 -- from its largest |error|).
 local defaults = { samples = 256, pattern = "r2", seed = 1, light = 1, repeats = 3, warmup = 1, images = true,
-                   exr = false, time_budget_s = 1, resource_budget_gib = 2, error_scale = 0.5 }
+                   exr = false, time_budget_s = 1, resource_budget_gib = 2, error_scale = 0.5, error = "all.rmse" }
 local spec_fields = { name = true, scenes = true, overrides = true, samples = true, pattern = true, seed = true,
                       light = true, repeats = true, warmup = true, images = true, exr = true, cache = true,
-                      description = true, time_budget_s = true, resource_budget_gib = true, error_scale = true }
+                      description = true, time_budget_s = true, resource_budget_gib = true, error_scale = true,
+                      error = true }
 
 local function merged(a, b)
   local m = {}
@@ -404,6 +405,14 @@ function Experiment:run_one(config, o, header)
   return row
 end
 
+-- The value of a metric path "region.field" (exp.error, the one its report
+-- plots) in a record's metrics: "-" for an empty region (null).
+local function metric_text(metrics, path)
+  local region, field = path:match("^(%w+)%.([%w_]+)$")
+  local v = region and metrics[region] and metrics[region][field]
+  return type(v) == "number" and string.format("%.5f", v) or "-"
+end
+
 local function progress(o, n, total, config, row)
   if o.quiet then return end
   local v = config.variant
@@ -412,10 +421,10 @@ local function progress(o, n, total, config, row)
     io.stderr:write(string.format("[%d/%d] %s on %s: ERROR %s\n", n, total, config.label, where, row.error))
     return
   end
-  local m, t = row.record.metrics, row.record.timings_s
-  io.stderr:write(string.format("[%d/%d] %s on %s: rmse %.5f, frame %.3f ms (eval %.3f ms, %s)\n", n, total,
-                                config.label, where, m.all.rmse, 1e3 * t.frame, 1e3 * t.evaluate_median,
-                                row.record.resource_cache))
+  local t = row.record.timings_s
+  io.stderr:write(string.format("[%d/%d] %s on %s: %s %s, frame %.3f ms (eval %.3f ms, %s)\n", n, total,
+                                config.label, where, o.error, metric_text(row.record.metrics, o.error),
+                                1e3 * t.frame, 1e3 * t.evaluate_median, row.record.resource_cache))
 end
 
 -- Rows measured by another build (commit, CPU, threads: records.build_of)
@@ -451,6 +460,7 @@ end
 function Experiment:run(argv)
   local o = (type(argv) == "table" and argv.parsed) and argv or experiment.parse_args(argv)
   o.out = o.out or ("reports/" .. self.name)
+  o.error = self.error -- the metric progress lines print: the one the report plots by default
   if o.images == nil then o.images = self.images end
   for _, k in ipairs({ "repeats", "warmup", "samples" }) do
     if o[k] then self[k] = o[k] end

@@ -354,7 +354,8 @@ function report.write(result, opts)
   if not time_fields[ctx.time] then
     error(string.format("report.write: unknown time '%s'; valid: %s", tostring(ctx.time), table.concat(time_order, ", ")), 2)
   end
-  ctx.err, ctx.err_label, ctx.noise, ctx.err_path = metric_getter(opts.error or "all.rmse")
+  local default_error = result.experiment and result.experiment.error or "all.rmse" -- experiment.new{error = ...}
+  ctx.err, ctx.err_label, ctx.noise, ctx.err_path = metric_getter(opts.error or default_error)
   local rows = ok_rows(result.rows)
   local axes = swept_names(rows)
   mark_swept(rows, axes)

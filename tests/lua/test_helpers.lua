@@ -364,6 +364,22 @@ test("records_carry_the_scene_overrides_as_written", function()
   assert(text == "camera.height=12 camera.width=16 lights[1].radius=0.1", "overrides: " .. text)
 end)
 
+test("experiment_progress_prints_the_metric_its_report_plots", function()
+  local out = tmp .. "/progress"
+  local exp = experiment.new{ name = "progress", samples = 4, repeats = 1, warmup = 0, error = "penumbra.rmse",
+                              overrides = { ["camera.width"] = 16, ["camera.height"] = 12 } }
+  exp:scene("scenes/sphere-on-plane.lua")
+  exp:add("hard")
+  local lines = {}
+  local real = io.stderr
+  io.stderr = { write = function(_, ...) for _, s in ipairs({ ... }) do lines[#lines + 1] = s end end }
+  local ok, err = pcall(function() exp:run({ "--out", out, "--no-images" }) end)
+  io.stderr = real
+  assert(ok, tostring(err))
+  local text = table.concat(lines)
+  assert(text:find("penumbra.rmse ", 1, true), "progress lines: " .. text)
+end)
+
 ---------------------------------------------------------------- plots
 
 local function fake_row(scene, samples, noise)
