@@ -37,6 +37,7 @@ static const OptDesc opts[OPT_COUNT] = {
     [OPT_NAMES] = {NULL, "--names", NULL, "the names only, one per line"},
     [OPT_CASE] = {NULL, "--case", "TEXT", "only cases whose name contains TEXT"},
     [OPT_QUICK] = {NULL, "--quick", NULL, "reduced sizes"},
+    [OPT_SAMPLE] = {NULL, "--sample", "K/M", "a deterministic sample of the runs"},
     [OPT_TIMEOUT] = {NULL, "--timeout", "S", "per-run time bound in seconds (default 120)"},
     [OPT_JOBS] = {NULL, "--jobs", "N", "runs at once (default 1)"},
     [OPT_LIST] = {NULL, "--list", NULL, "list and exit"},
@@ -49,6 +50,23 @@ static bool parse_int(const char *opt, const char *s, int lo, int hi, int *out, 
     if (end == s || *end != '\0' || v < lo || v > hi)
         return error_set(err, "%s expects an integer in [%d, %d], got '%s'", opt, lo, hi, s);
     *out = (int)v;
+    return true;
+}
+
+/* "K/M" with 0 <= K < M <= 64. */
+static bool parse_sample(const char *a, const char *v, int *k, int *m, Error *err)
+{
+    char *end;
+    long kk = strtol(v, &end, 10), mm = 0;
+    if (end != v && *end == '/') {
+        const char *mv = end + 1;
+        mm = strtol(mv, &end, 10);
+        if (end == mv) mm = 0;
+    }
+    if (*end != '\0' || mm < 1 || mm > 64 || kk < 0 || kk >= mm)
+        return error_set(err, "%s expects K/M with 0 <= K < M <= 64, got '%s'", a, v);
+    *k = (int)kk;
+    *m = (int)mm;
     return true;
 }
 
@@ -99,6 +117,7 @@ static bool apply(CliOpt id, const char *a, const char *v, CliOptions *o, Error 
     case OPT_NAMES: o->names = true; return true;
     case OPT_CASE: o->case_filter = v; return true;
     case OPT_QUICK: o->quick = true; return true;
+    case OPT_SAMPLE: return parse_sample(a, v, &o->sample_k, &o->sample_m, err);
     case OPT_TIMEOUT: return parse_seconds(a, v, 1, 86400, &o->timeout_s, err);
     case OPT_JOBS: return parse_int(a, v, 1, 16, &o->jobs, err);
     case OPT_LIST: o->list = true; return true;

@@ -18,7 +18,7 @@ typedef enum CliOpt {
     OPT_SAMPLES, OPT_PATTERN, OPT_SEED, OPT_MEASURE, OPT_CACHE, OPT_NO_CACHE,
     OPT_REPEAT, OPT_WARMUP, OPT_THREADS, OPT_OUT, OPT_NO_PNG, OPT_FRUSTUM,
     OPT_JSON, OPT_MARKDOWN, OPT_README, OPT_NAMES,
-    OPT_CASE, OPT_QUICK, OPT_TIMEOUT, OPT_JOBS, OPT_LIST,
+    OPT_CASE, OPT_QUICK, OPT_SAMPLE, OPT_TIMEOUT, OPT_JOBS, OPT_LIST,
     OPT_COUNT
 } CliOpt;
 
@@ -55,6 +55,7 @@ typedef struct CliOptions {
     bool quick, list;      /* stability */
     double timeout_s;      /* stability: per run (0: the suite's default) */
     int jobs;              /* stability: runs at once (0: 1) */
+    int sample_k, sample_m; /* stability: --sample K/M, the runs of hash class K of M (m 0: all) */
     unsigned long long given; /* bit (1ull << CliOpt) of every option given */
 } CliOptions;
 

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include "core/hash.h"
 #include "core/fsutil.h"
 #include "core/timer.h"
 #include "io/exr.h"
@@ -132,9 +133,22 @@ static StabSettings settings(bool quick)
 
 /* A run of case c (NULL: a parameter probe); a case whose limit is stated
  * at the full sizes keeps them in quick runs too. */
+/* Is the run of t on this case or probe and light in the sample (StabOptions)? */
+static bool sampled(const Runner *rn, const Technique *t, const char *name, LightKind kind)
+{
+    if (rn->o->sample_m <= 1) return true;
+    Hasher h;
+    hash_init(&h);
+    hash_str(&h, t ? t->name : "(engine)");
+    hash_str(&h, name);
+    hash_u64(&h, (uint64_t)kind);
+    return hash_final(&h) % (uint64_t)rn->o->sample_m == (uint64_t)rn->o->sample_k;
+}
+
 static void add_job(Runner *rn, const Technique *t, const StabCase *c, int param, ParamProbe probe, LightKind kind,
                     const char *name)
 {
+    if (!sampled(rn, t, name, kind)) return;
     StabJob *jobs = array_room(rn->jobs, rn->num_jobs, &rn->cap, sizeof *jobs, 256);
     if (!jobs) {
         rn->oom = true;

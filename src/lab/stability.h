@@ -28,6 +28,8 @@ typedef struct StabOptions {
     const char *work_dir;  /* existing scratch folder for scene files and child logs */
     const char *scene_dir; /* if set, every case's scene file is kept there (to reproduce a row) */
     int jobs;              /* runs at once; 0: 1 */
+    int sample_k, sample_m; /* sample_m > 1: only the runs whose FNV-1a hash of "technique case light"
+                             * is K modulo M, a deterministic sample; every technique keeps ~1/M */
 } StabOptions;
 
 /* Quick runs: view size, reference light samples, and the cap on integer
