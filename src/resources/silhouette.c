@@ -235,13 +235,20 @@ void silhouette_free(Silhouette *sil)
 
 Silhouette *silhouette_build(const Scene *scene, int light_index, Error *err)
 {
+    double L[4];
+    light_centre(&scene->lights[light_index], L);
+    return silhouette_build_point(scene, L, err);
+}
+
+Silhouette *silhouette_build_point(const Scene *scene, const double L[4], Error *err)
+{
     Silhouette *sil = calloc(1, sizeof *sil);
     if (!sil || !(sil->objects = calloc((size_t)scene->num_objects + 1, sizeof *sil->objects))) {
         free(sil);
         error_set(err, "out of memory for the silhouette of %d objects", scene->num_objects);
         return NULL;
     }
-    light_centre(&scene->lights[light_index], sil->light);
+    memcpy(sil->light, L, sizeof sil->light);
     int cap = 0;
     for (int o = 0; o < scene->num_objects; o++) {
         const Object *ob = &scene->objects[o];
@@ -301,27 +308,33 @@ static void sil_destroy(void *res) { silhouette_free(res); }
 
 static const ResourceKind kind_silhouette = {"silhouette", sil_bytes, sil_destroy, RES_FRAME};
 
-typedef struct SilArgs { const Scene *scene; int light_index; } SilArgs;
+typedef struct SilArgs { const Scene *scene; const double *L; } SilArgs;
 
 static void *build_sil(const void *args, Error *err)
 {
     const SilArgs *a = args;
-    return silhouette_build(a->scene, a->light_index, err);
+    return silhouette_build_point(a->scene, a->L, err);
 }
 
 const Silhouette *res_silhouette(ResourceManager *rm, const Scene *scene, int light_index, Error *err)
 {
     double L[4];
     light_centre(&scene->lights[light_index], L);
+    char desc[160];
+    snprintf(desc, sizeof desc, "casters, centre of light %d", light_index + 1);
+    return res_silhouette_point(rm, scene, L, desc, err);
+}
+
+const Silhouette *res_silhouette_point(ResourceManager *rm, const Scene *scene, const double L[4], const char *desc,
+                                       Error *err)
+{
     Hasher h;
     hash_init(&h);
     hash_str(&h, "silhouette 1");
     hash_u64(&h, scene->hash_casters);
     for (int k = 0; k < 4; k++) hash_f64(&h, L[k]);
     uint64_t key = hash_final(&h);
-    char desc[160];
-    snprintf(desc, sizeof desc, "casters, centre of light %d", light_index + 1);
-    SilArgs a = {scene, light_index};
+    SilArgs a = {scene, L};
     Silhouette *sil = rm_acquire(rm, &kind_silhouette, key, desc, build_sil, &a, err);
     if (!sil) return NULL;
     sil->key = key;

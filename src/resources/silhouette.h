@@ -61,8 +61,15 @@ typedef struct Silhouette {
 
 const Silhouette *res_silhouette(ResourceManager *rm, const Scene *scene, int light_index, Error *err);
 
+/* The same for any homogeneous point L (silhouette.h's `light`), e.g. the
+ * centre of a patch of an area light (soft shadow volumes' light splitting);
+ * keyed by the casters and L, `desc` naming the point in the resource log. */
+const Silhouette *res_silhouette_point(ResourceManager *rm, const Scene *scene, const double L[4], const char *desc,
+                                       Error *err);
+
 /* Build one without a manager (tests, the bench); free with silhouette_free. */
 Silhouette *silhouette_build(const Scene *scene, int light_index, Error *err);
+Silhouette *silhouette_build_point(const Scene *scene, const double L[4], Error *err);
 void silhouette_free(Silhouette *sil);
 
 /* "'name': 12 open, 1 non-manifold edges, 2 zero-area triangles skipped"
