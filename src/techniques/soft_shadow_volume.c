@@ -32,9 +32,9 @@
  * exact term.
  *
  * Lights: a rectangle and a disk in their own plane; a sphere as the disk
- * through its centre facing p (one patch) or facing the scene's centre
- * (split: the patches' centres must be fixed points, each with its own
- * volume). Splitting into 2x2 or 3x3 patches (Assarsson et al. 2003) gives
+ * through its centre facing p. A split sphere's patch centres are fixed
+ * points (each has its own volume) on the disk facing the scene's centre,
+ * projected from p onto the plane facing p (domain_at). Splitting into 2x2 or 3x3 patches (Assarsson et al. 2003) gives
  * each patch its own centre silhouette, which shortens the edges' reach and
  * the popping when a centre silhouette changes. */
 #include <math.h>
@@ -78,7 +78,7 @@ typedef struct Patch {
 typedef struct SsvState {
     int term;           /* TERM_EXACT or TERM_LINEAR */
     bool round;         /* disk or sphere: cells are cut by the disk */
-    bool facing;        /* sphere, one patch: the disk faces each sample */
+    bool facing;        /* sphere: the disk faces each sample */
     dvec3 c0, t0, b0, n0; /* the light's centre and fixed frame (n0 toward the scene) */
     double radius;      /* round lights (world units) */
     double hx, hy;      /* a cell's half sides (world units) */
@@ -146,12 +146,13 @@ static double poly_area(const P2 *poly, int n, bool round, P2 o, double r)
     return a;
 }
 
-static int cell_poly(const SsvState *st, P2 *poly)
+/* The rectangle of centre c and half sides hx, hy, counter-clockwise. */
+static int rect_poly(P2 c, double hx, double hy, P2 *poly)
 {
-    poly[0] = (P2){-st->hx, -st->hy};
-    poly[1] = (P2){st->hx, -st->hy};
-    poly[2] = (P2){st->hx, st->hy};
-    poly[3] = (P2){-st->hx, st->hy};
+    poly[0] = (P2){c.x - hx, c.y - hy};
+    poly[1] = (P2){c.x + hx, c.y - hy};
+    poly[2] = (P2){c.x + hx, c.y + hy};
+    poly[3] = (P2){c.x - hx, c.y + hy};
     return 4;
 }
 
@@ -161,8 +162,12 @@ static int cell_poly(const SsvState *st, P2 *poly)
 typedef struct Domain {
     P2 poly[POLY_MAX];
     int n;
-    P2 o;               /* the disk's centre from the patch centre */
-    double area;        /* |K| (world units^2) */
+    P2 cell;            /* the cell's centre */
+    double hx, hy;      /* its half sides */
+    P2 o;               /* the disk's centre */
+    double r;           /* its radius */
+    double scale;       /* lengths on this plane over those on the light's own (see domain_at) */
+    double area;        /* |K| on this plane (world units^2) */
 } Domain;
 
 /* Exact term (2003): |R_e|, K beyond the projected edge a -> b inside the
@@ -176,7 +181,7 @@ static double term_exact(const SsvState *st, const Domain *k, P2 a, P2 b, double
     n = clip_half_plane(poly, n, -s * a.y, s * a.x, 0.0);  /* s cross(a, x) >= 0 */
     n = clip_half_plane(poly, n, s * b.y, -s * b.x, 0.0);  /* s cross(x, b) >= 0 */
     n = clip_half_plane(poly, n, s * u.y, -s * u.x, s * cross2(u, a)); /* s cross(u, x - a) <= 0: beyond */
-    return n >= 3 ? poly_area(poly, n, st->round, k->o, st->radius) : 0.0;
+    return n >= 3 ? poly_area(poly, n, st->round, k->o, k->r) : 0.0;
 }
 
 /* Linear term (2002): the light as a ramp across the edge's infinite line,
@@ -191,9 +196,10 @@ static double term_linear(const SsvState *st, const Domain *k, P2 a, P2 b)
     double foot = -(a.x * u.x + a.y * u.y) / uu;
     if (foot < 0.0 || foot >= 1.0) return 0.0;
     double len = sqrt(uu), nx = -u.y / len, ny = u.x / len, d = fabs(cross2(a, b)) / len;
-    double e = st->hx * fabs(nx) + st->hy * fabs(ny); /* the cell's half extent across the line */
+    /* the light's half extent across the line, from the origin */
+    double e = k->hx * fabs(nx) + k->hy * fabs(ny) + fabs(k->cell.x * nx + k->cell.y * ny);
     if (st->round) {
-        double disk = st->radius + fabs(o.x * nx + o.y * ny);
+        double disk = k->r + fabs(o.x * nx + o.y * ny);
         e = disk < e ? disk : e;
     }
     if (!(e > 0.0)) return 0.0;
@@ -215,9 +221,11 @@ static void basis(dvec3 n, dvec3 *t, dvec3 *b)
 static Frame frame_at(const SsvState *st, dvec3 p)
 {
     Frame f = {st->t0, st->b0, st->n0};
-    if (st->facing) {
+    if (st->facing) { /* t: the fixed frame's, turned into the facing plane */
         f.n = d3_normalize_or(d3_sub(p, st->c0), st->n0);
-        basis(f.n, &f.t, &f.b);
+        f.t = d3_normalize_or(d3_madd(st->t0, f.n, -d3_dot(st->t0, f.n)), d3(0, 0, 0));
+        if (d3_dot(f.t, f.t) == 0.0) basis(f.n, &f.t, &f.b);
+        f.b = d3_cross(f.n, f.t);
     } else if (d3_dot(d3_sub(p, st->c0), st->n0) < 0.0) {
         f.n = d3_scale(st->n0, -1.0);
         f.b = d3_scale(st->b0, -1.0);
@@ -240,20 +248,31 @@ static bool edge_may_meet(dvec3 p, dvec3 c, double rb, dvec3 a, dvec3 b)
     return radial <= (along + hl) * (sin_t / cos_t) + hl / cos_t;
 }
 
-/* K for patch pa at p (normal n_p, geometric): the cell cut by p's tangent
- * plane, n_p . (c + x t + y b - p) >= 0; a part too thin to have area leaves
- * the whole cell (its visible fraction tends to that of its highest point,
- * as the reference's one ray). */
+/* K for patch pa at p (normal n_p, geometric), on the plane through the
+ * patch's centre c_i parallel to the light's (through c0, normal f.n): the
+ * light's cell and disk projected from p onto it, which scales them about p
+ * by s = h_i / h_0 (the heights of p above the two planes; s = 1 but for a
+ * sphere's patches, whose fixed centres lie off the plane facing p), cut by
+ * p's tangent plane n_p . (c_i + x t + y b - p) >= 0. A part too thin to
+ * have area leaves the whole cell (its visible fraction tends to that of its
+ * highest point, as the reference's one ray). */
 static void domain_at(const SsvState *st, const Patch *pa, dvec3 p, dvec3 n_p, const Frame *f, Domain *k)
 {
-    bool flip = !st->facing && d3_dot(f->n, st->n0) < 0.0;
-    k->o = (P2){-pa->u, flip ? pa->v : -pa->v};
-    k->n = cell_poly(st, k->poly);
+    double h0 = d3_dot(d3_sub(p, st->c0), f->n), hi = d3_dot(d3_sub(p, pa->centre), f->n);
+    double s = h0 > 0.0 && hi > 0.0 ? hi / h0 : 1.0, side = d3_dot(f->b, st->b0) < 0.0 ? -1.0 : 1.0;
+    dvec3 g = d3_add(d3_scale(d3_sub(st->c0, p), s), d3_sub(p, pa->centre)); /* c0 projected, from c_i */
+    k->o = (P2){d3_dot(g, f->t), d3_dot(g, f->b)};
+    k->cell = (P2){k->o.x + s * pa->u, k->o.y + s * side * pa->v};
+    k->hx = s * st->hx;
+    k->hy = s * st->hy;
+    k->r = s * st->radius;
+    k->scale = s;
+    k->n = rect_poly(k->cell, k->hx, k->hy, k->poly);
+    k->area = poly_area(k->poly, k->n, st->round, k->o, k->r);
     Domain above = *k;
     above.n = clip_half_plane(above.poly, above.n, d3_dot(n_p, f->t), d3_dot(n_p, f->b), d3_dot(n_p, d3_sub(pa->centre, p)));
-    above.area = above.n >= 3 ? poly_area(above.poly, above.n, st->round, above.o, st->radius) : 0.0;
-    k->area = pa->area;
-    if (above.area > 1e-9 * pa->area) *k = above;
+    above.area = above.n >= 3 ? poly_area(above.poly, above.n, st->round, above.o, above.r) : 0.0;
+    if (above.area > 1e-9 * k->area) *k = above;
 }
 
 /* A patch's covered area of K at p: w |K| plus its silhouette edges' terms. */
@@ -262,7 +281,7 @@ static double patch_covered(const SsvState *st, const Patch *pa, int32_t w, dvec
     dvec3 c = pa->centre;
     double hp = d3_dot(d3_sub(p, c), f->n);
     if (!(hp > 0.0)) return w != 0 ? k->area : 0.0; /* p on the light's plane: the centre decides */
-    double rb = sqrt(st->hx * st->hx + st->hy * st->hy), hmax = hp * (1.0 - 1e-6), a_cov = (double)w * k->area;
+    double rb = sqrt(k->cell.x * k->cell.x + k->cell.y * k->cell.y) + sqrt(k->hx * k->hx + k->hy * k->hy), hmax = hp * (1.0 - 1e-6), a_cov = (double)w * k->area;
     for (int i = 0; i < pa->sil->num_edges; i++) {
         const SilEdge *e = &pa->sil->edges[i];
         dvec3 a = d3_from(e->a), b = d3_from(e->b);
@@ -297,7 +316,8 @@ static double patch_covered(const SsvState *st, const Patch *pa, int32_t w, dvec
     return a_cov;
 }
 
-/* The covered fraction of the light's part above p's tangent plane. */
+/* The covered fraction of the light's part above p's tangent plane, each
+ * patch's areas taken back to the light's own plane (over s^2). */
 static double covered_fraction(const SsvState *st, const ViewSamples *vs, int s)
 {
     dvec3 p = d3_from(vs->p_world[s]), n_p = d3_from(vs->n_geom_world[s]);
@@ -306,8 +326,9 @@ static double covered_fraction(const SsvState *st, const ViewSamples *vs, int s)
     for (int i = 0; i < st->num_patches; i++) {
         Domain k;
         domain_at(st, &st->patch[i], p, n_p, &f, &k);
-        covered += patch_covered(st, &st->patch[i], st->patch[i].count[s], p, &f, &k);
-        area += k.area;
+        double back = 1.0 / (k.scale * k.scale);
+        covered += back * patch_covered(st, &st->patch[i], st->patch[i].count[s], p, &f, &k);
+        area += back * k.area;
     }
     return covered / area; /* area > 0: light_shape refuses a light without one */
 }
@@ -339,7 +360,7 @@ static void light_shape(const TechContext *ctx, int per_side, SsvState *st)
     const Light *l = ctx->light;
     st->c0 = d3_from(l->position);
     st->round = l->kind != LIGHT_RECT;
-    st->facing = l->kind == LIGHT_SPHERE && per_side == 1;
+    st->facing = l->kind == LIGHT_SPHERE;
     if (l->kind == LIGHT_SPHERE) {
         const Scene *sc = ctx->scene;
         dvec3 mid = d3_scale(d3_add(d3_from(sc->bounds_min), d3_from(sc->bounds_max)), 0.5);
@@ -364,8 +385,8 @@ static void light_shape(const TechContext *ctx, int per_side, SsvState *st)
             pa->v = -ey + (2 * j + 1) * st->hy;
             pa->centre = d3_madd(d3_madd(st->c0, st->t0, pa->u), st->b0, pa->v);
             P2 poly[POLY_MAX];
-            int n = cell_poly(st, poly);
-            pa->area = poly_area(poly, n, st->round, (P2){-pa->u, -pa->v}, st->radius);
+            int n = rect_poly((P2){pa->u, pa->v}, st->hx, st->hy, poly);
+            pa->area = poly_area(poly, n, st->round, (P2){0.0, 0.0}, st->radius);
             st->area += pa->area;
         }
 }
