@@ -253,10 +253,8 @@ static bool edge_may_meet(dvec3 p, dvec3 c, double rb, dvec3 a, dvec3 b)
  * light's cell and disk projected from p onto it, which scales them about p
  * by s = h_i / h_0 (the heights of p above the two planes; s = 1 but for a
  * sphere's patches, whose fixed centres lie off the plane facing p), cut by
- * p's tangent plane n_p . (c_i + x t + y b - p) >= 0. A part too thin to
- * have area leaves the whole cell (its visible fraction tends to that of its
- * highest point, as the reference's one ray). */
-static void domain_at(const SsvState *st, const Patch *pa, dvec3 p, dvec3 n_p, const Frame *f, Domain *k)
+ * p's tangent plane n_p . (c_i + x t + y b - p) >= 0 when `cut`. */
+static void domain_at(const SsvState *st, const Patch *pa, dvec3 p, dvec3 n_p, const Frame *f, bool cut, Domain *k)
 {
     double h0 = d3_dot(d3_sub(p, st->c0), f->n), hi = d3_dot(d3_sub(p, pa->centre), f->n);
     double s = h0 > 0.0 && hi > 0.0 ? hi / h0 : 1.0, side = d3_dot(f->b, st->b0) < 0.0 ? -1.0 : 1.0;
@@ -268,11 +266,9 @@ static void domain_at(const SsvState *st, const Patch *pa, dvec3 p, dvec3 n_p, c
     k->r = s * st->radius;
     k->scale = s;
     k->n = rect_poly(k->cell, k->hx, k->hy, k->poly);
-    k->area = poly_area(k->poly, k->n, st->round, k->o, k->r);
-    Domain above = *k;
-    above.n = clip_half_plane(above.poly, above.n, d3_dot(n_p, f->t), d3_dot(n_p, f->b), d3_dot(n_p, d3_sub(pa->centre, p)));
-    above.area = above.n >= 3 ? poly_area(above.poly, above.n, st->round, above.o, above.r) : 0.0;
-    if (above.area > 1e-9 * k->area) *k = above;
+    if (cut)
+        k->n = clip_half_plane(k->poly, k->n, d3_dot(n_p, f->t), d3_dot(n_p, f->b), d3_dot(n_p, d3_sub(pa->centre, p)));
+    k->area = k->n >= 3 ? poly_area(k->poly, k->n, st->round, k->o, k->r) : 0.0;
 }
 
 /* A patch's covered area of K at p: w |K| plus its silhouette edges' terms. */
@@ -317,19 +313,25 @@ static double patch_covered(const SsvState *st, const Patch *pa, int32_t w, dvec
 }
 
 /* The covered fraction of the light's part above p's tangent plane, each
- * patch's areas taken back to the light's own plane (over s^2). */
+ * patch's areas taken back to the light's own plane (over s^2); a part too
+ * thin to have area leaves the whole light (its visible fraction tends to
+ * that of its highest point, as the reference's one ray). */
 static double covered_fraction(const SsvState *st, const ViewSamples *vs, int s)
 {
     dvec3 p = d3_from(vs->p_world[s]), n_p = d3_from(vs->n_geom_world[s]);
     Frame f = frame_at(st, p);
-    double covered = 0.0, area = 0.0;
-    for (int i = 0; i < st->num_patches; i++) {
-        Domain k;
-        domain_at(st, &st->patch[i], p, n_p, &f, &k);
-        double back = 1.0 / (k.scale * k.scale);
-        covered += back * patch_covered(st, &st->patch[i], st->patch[i].count[s], p, &f, &k);
-        area += back * k.area;
+    Domain k[MAX_PER_SIDE * MAX_PER_SIDE];
+    double area = 0.0, covered = 0.0;
+    for (int cut = 1; cut >= 0 && !(area > 1e-9 * st->area); cut--) {
+        area = 0.0;
+        for (int i = 0; i < st->num_patches; i++) {
+            domain_at(st, &st->patch[i], p, n_p, &f, cut, &k[i]);
+            area += k[i].area / (k[i].scale * k[i].scale);
+        }
     }
+    for (int i = 0; i < st->num_patches; i++)
+        if (k[i].area > 0.0)
+            covered += patch_covered(st, &st->patch[i], st->patch[i].count[s], p, &f, &k[i]) / (k[i].scale * k[i].scale);
     return covered / area; /* area > 0: light_shape refuses a light without one */
 }
 
