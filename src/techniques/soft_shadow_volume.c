@@ -411,7 +411,8 @@ static bool ssv_prepare_term(const TechContext *ctx, void **state, int term, Err
         char desc[160];
         snprintf(desc, sizeof desc, "casters, patch %d of %d of light %d", i + 1, st->num_patches, ctx->light_index + 1);
         RasterStats fill;
-        pa->sil = res_silhouette_point(ctx->rm, ctx->scene, L, desc, err);
+        /* shells counted once: the coverage integrates the counts (silhouette.h) */
+        pa->sil = res_silhouette_point(ctx->rm, ctx->scene, L, SIL_SHELLS_DARK_SIDE, desc, err);
         pa->count = malloc(sizeof *pa->count * (size_t)(ctx->vs->count + 1));
         if (!pa->count) error_set(err, "%s: out of memory for %d counts", name, ctx->vs->count);
         if (!pa->sil || !pa->count ||
