@@ -36,7 +36,13 @@
  * points (each has its own volume) on the disk facing the scene's centre,
  * projected from p onto the plane facing p (domain_at). Splitting into 2x2 or 3x3 patches (Assarsson et al. 2003) gives
  * each patch its own centre silhouette, which shortens the edges' reach and
- * the popping when a centre silhouette changes. */
+ * the popping when a centre silhouette changes.
+ *
+ * Cost: each sample tests every silhouette edge of each patch against the
+ * edge's wedge (a bounding cone, edge_may_meet) instead of rasterising the
+ * wedges from the camera as the paper's GPU pass does, so evaluation is
+ * O(samples x edges x patches): at 160x120 on one core 0.03 s on
+ * sphere-on-plane, 0.7-1.4 s on the bunny (the 1024-sample reference: 1.1 s). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
