@@ -162,7 +162,7 @@ static void count_edges(ObjectBuild *ob)
 
 /* Classify every edge, set the triangle weights and append the silhouette
  * edges of this object. */
-static bool collect(ObjectBuild *ob, SilObject *so, Silhouette *sil, int *cap)
+static bool collect(ObjectBuild *ob, SilRule rule, SilObject *so, Silhouette *sil, int *cap)
 {
     EdgeTable *t = &ob->edges;
     for (size_t i = 0; i < t->size; i++) {
@@ -174,14 +174,16 @@ static bool collect(ObjectBuild *ob, SilObject *so, Silhouette *sil, int *cap)
         so->misoriented_edges += e->triangles == 2 && e->dir_sum != 0;
     }
     so->closed = so->open_edges == 0 && so->nonmanifold_edges == 0 && so->misoriented_edges == 0;
+    bool shell = so->nonmanifold_edges == 0 && so->misoriented_edges == 0 && so->open_edges * SIL_SHELL_OPEN < so->edges;
+    bool dark = so->closed || (rule == SIL_SHELLS_DARK_SIDE && shell);
     for (int k = 0; k < ob->mesh->num_triangles; k++) {
         int f = ob->facing[k];
-        so->weight[k] = (int8_t)(f == 2 ? 0 : so->closed ? -(f < 0) : f);
+        so->weight[k] = (int8_t)(f == 2 ? 0 : dark ? -(f < 0) : f);
     }
     const vec3 *pos = ob->mesh->positions;
     for (size_t i = 0; i < t->size; i++) {
         const EdgeSlot *e = &t->slot[i];
-        int m = so->closed ? e->back_sum : e->signed_sum;
+        int m = dark ? e->back_sum : e->signed_sum;
         if (!e->triangles || m == 0) continue;
         SilEdge *edges = array_room(sil->edges, sil->num_edges, cap, sizeof *edges, 256);
         if (!edges) return false;
@@ -193,7 +195,7 @@ static bool collect(ObjectBuild *ob, SilObject *so, Silhouette *sil, int *cap)
     return true;
 }
 
-static bool build_object(const Mesh *m, const double L[4], SilObject *so, Silhouette *sil, int *cap)
+static bool build_object(const Mesh *m, const double L[4], SilRule rule, SilObject *so, Silhouette *sil, int *cap)
 {
     size_t nv = (size_t)m->num_vertices, nt = (size_t)m->num_triangles;
     ObjectBuild ob = {m, malloc(sizeof(uint32_t) * nv), {NULL, calloc(nv + 1, sizeof(uint32_t)),
@@ -203,7 +205,7 @@ static bool build_object(const Mesh *m, const double L[4], SilObject *so, Silhou
     if (ok) classify_triangles(&ob, L, so);
     ok = ok && (ob.edges.slot = calloc(ob.edges.size + 1, sizeof *ob.edges.slot)) != NULL;
     if (ok) count_edges(&ob);
-    ok = ok && collect(&ob, so, sil, cap);
+    ok = ok && collect(&ob, rule, so, sil, cap);
     free(ob.weld);
     free(ob.edges.slot);
     free(ob.edges.start);
@@ -235,13 +237,20 @@ void silhouette_free(Silhouette *sil)
 
 Silhouette *silhouette_build(const Scene *scene, int light_index, Error *err)
 {
+    double L[4];
+    light_centre(&scene->lights[light_index], L);
+    return silhouette_build_point(scene, L, SIL_BERGERON, err);
+}
+
+Silhouette *silhouette_build_point(const Scene *scene, const double L[4], SilRule rule, Error *err)
+{
     Silhouette *sil = calloc(1, sizeof *sil);
     if (!sil || !(sil->objects = calloc((size_t)scene->num_objects + 1, sizeof *sil->objects))) {
         free(sil);
         error_set(err, "out of memory for the silhouette of %d objects", scene->num_objects);
         return NULL;
     }
-    light_centre(&scene->lights[light_index], sil->light);
+    memcpy(sil->light, L, sizeof sil->light);
     int cap = 0;
     for (int o = 0; o < scene->num_objects; o++) {
         const Object *ob = &scene->objects[o];
@@ -249,7 +258,7 @@ Silhouette *silhouette_build(const Scene *scene, int light_index, Error *err)
         SilObject *so = &sil->objects[sil->num_objects++];
         so->object = o;
         so->triangles = ob->mesh.num_triangles;
-        if (!build_object(&ob->mesh, sil->light, so, sil, &cap)) {
+        if (!build_object(&ob->mesh, sil->light, rule, so, sil, &cap)) {
             silhouette_free(sil);
             error_set(err, "out of memory for the edge adjacency of object '%s' (%d triangles)", ob->name,
                       ob->mesh.num_triangles);
@@ -301,27 +310,34 @@ static void sil_destroy(void *res) { silhouette_free(res); }
 
 static const ResourceKind kind_silhouette = {"silhouette", sil_bytes, sil_destroy, RES_FRAME};
 
-typedef struct SilArgs { const Scene *scene; int light_index; } SilArgs;
+typedef struct SilArgs { const Scene *scene; const double *L; SilRule rule; } SilArgs;
 
 static void *build_sil(const void *args, Error *err)
 {
     const SilArgs *a = args;
-    return silhouette_build(a->scene, a->light_index, err);
+    return silhouette_build_point(a->scene, a->L, a->rule, err);
 }
 
 const Silhouette *res_silhouette(ResourceManager *rm, const Scene *scene, int light_index, Error *err)
 {
     double L[4];
     light_centre(&scene->lights[light_index], L);
+    char desc[160];
+    snprintf(desc, sizeof desc, "casters, centre of light %d", light_index + 1);
+    return res_silhouette_point(rm, scene, L, SIL_BERGERON, desc, err);
+}
+
+const Silhouette *res_silhouette_point(ResourceManager *rm, const Scene *scene, const double L[4], SilRule rule,
+                                       const char *desc, Error *err)
+{
     Hasher h;
     hash_init(&h);
     hash_str(&h, "silhouette 1");
     hash_u64(&h, scene->hash_casters);
     for (int k = 0; k < 4; k++) hash_f64(&h, L[k]);
+    if (rule != SIL_BERGERON) hash_u64(&h, (uint64_t)rule); /* the centre's resource keeps its key */
     uint64_t key = hash_final(&h);
-    char desc[160];
-    snprintf(desc, sizeof desc, "casters, centre of light %d", light_index + 1);
-    SilArgs a = {scene, light_index};
+    SilArgs a = {scene, L, rule};
     Silhouette *sil = rm_acquire(rm, &kind_silhouette, key, desc, build_sil, &a, err);
     if (!sil) return NULL;
     sil->key = key;

@@ -30,6 +30,8 @@ extern const Technique tech_backprojection;
 extern const Technique tech_light_sampling;
 extern const Technique tech_occlusion_textures;
 extern const Technique tech_shadow_volume;
+extern const Technique tech_soft_shadow_volume;
+extern const Technique tech_penumbra_wedge;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -56,6 +58,8 @@ static const Technique *const registry[] = {
     &tech_light_sampling,
     &tech_occlusion_textures,
     &tech_shadow_volume,
+    &tech_soft_shadow_volume,
+    &tech_penumbra_wedge,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }

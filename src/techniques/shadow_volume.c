@@ -19,7 +19,7 @@
 #include "raster/camera_count.h"
 #include "resources/silhouette.h"
 #include "resources/standard.h"
-#include "techniques/technique.h"
+#include "techniques/shadow_volume.h"
 
 static const char *const method_names[] = {"zpass", "zfail", "zpplus", NULL};
 static const char *const extrusion_names[] = {"infinite", "finite", NULL};
@@ -215,9 +215,9 @@ static float *test_depths(const TechContext *ctx, double offset_scale)
 }
 
 static bool count_volumes(const TechContext *ctx, const Volume *v, const Volume *near_caps, const double L[4],
-                          int method, int32_t *out, RasterStats *stats, Error *err)
+                          int method, double offset_scale, int32_t *out, RasterStats *stats, Error *err)
 {
-    float *depth = test_depths(ctx, ctx->params[SV_OFFSET]);
+    float *depth = test_depths(ctx, offset_scale);
     if (!depth) return error_set(err, "out of memory for %d test depths", ctx->vs->count);
     CameraCount cc;
     bool ok = camera_count_init(&cc, &ctx->scene->camera, ctx->vs, depth, err);
@@ -249,6 +249,18 @@ static bool count_volumes(const TechContext *ctx, const Volume *v, const Volume 
         out[s] = method != METHOD_ZFAIL ? c : c == INT32_MIN ? INT32_MAX : -c;
     }
     camera_count_free(&cc);
+    return ok;
+}
+
+bool shadow_volume_zfail_counts(const TechContext *ctx, const Silhouette *sil, double offset_scale, int32_t *count,
+                                RasterStats *fill, Error *err)
+{
+    Extrude e = {{sil->light[0], sil->light[1], sil->light[2], sil->light[3]}, true, 0.0f};
+    Volume v;
+    if (!volume_build(ctx->scene, sil, &e, PART_SIDES | PART_NEAR_CAPS | PART_FAR_CAPS, &v, err)) return false;
+    *fill = (RasterStats){0};
+    bool ok = count_volumes(ctx, &v, NULL, sil->light, METHOD_ZFAIL, offset_scale, count, fill, err);
+    volume_free(&v);
     return ok;
 }
 
@@ -286,8 +298,8 @@ static void *build_counts(const void *args, Error *err)
     int32_t *count = malloc(sizeof *count * (size_t)ctx->vs->count);
     RasterStats fill = {0};
     bool ok = c && count &&
-              count_volumes(ctx, &v, method == METHOD_ZPPLUS ? &near_caps : NULL, a->sil->light, method, count, &fill,
-                            err);
+              count_volumes(ctx, &v, method == METHOD_ZPPLUS ? &near_caps : NULL, a->sil->light, method,
+                            ctx->params[SV_OFFSET], count, &fill, err);
     if (!c || !count) error_set(err, "out of memory for %d shadow-volume counts", ctx->vs->count);
     volume_free(&v);
     volume_free(&near_caps);
