@@ -74,8 +74,10 @@ static double hardened(double x)
 
 static double dpcf_visibility(const DpcfState *st, const SmapReceiver *r, uint32_t sample)
 {
-    FsWindow w = filtsoft_search_window(&st->fs, r);
-    if (!filtsoft_may_block(&st->fs, r, w)) return 1.0;
+    FsWindow w;
+    double z_min;
+    if (!filtsoft_search(&st->fs, r, &w, &z_min)) return 1.0;
+    if (isnan(z_min)) return NAN; /* a NaN depth in reach: no taps to place */
     double cs, sn, depth_sum = 0.0;
     int occluded = 0;
     softmap_rotation(st->rotate, sample, &cs, &sn);
