@@ -247,6 +247,9 @@ TEST(test_filtered_soft_blocker_mean_carries_nan)
     CHECK(filtsoft_blocker_mean(NAN, 0.5, 0.8, 1e-4, &z) && z != z);
     CHECK(!filtsoft_blocker_mean(0.8, 1.0, 0.8, 1e-4, &z));
     CHECK(filtsoft_blocker_mean(0.5, 0.5, 0.8, 1e-4, &z) && fabs(z - 0.2) < 1e-12); /* 0.5 = 0.5 0.8 + 0.5 z */
+    /* chebyshev_upper, which every vsm-family technique reads: a NaN moment or depth is no bound, never 1 (lit) */
+    CHECK(isnan(chebyshev_upper(NAN, 0.5, 0.8, 1e-6)) && isnan(chebyshev_upper(0.5, NAN, 0.8, 1e-6)));
+    CHECK(isnan(chebyshev_upper(0.5, 0.3, NAN, 1e-6)));
 }
 
 /* Contact (scenes/contact.lua: boxes resting on the floor under a 1.5 x 1.5
