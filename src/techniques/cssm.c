@@ -122,11 +122,12 @@ static bool cssm_blocker(const CssmState *st, const SmapReceiver *r, FsWindow w,
 
 static double cssm_visibility(const CssmState *st, const SmapReceiver *r)
 {
-    FsWindow ws = filtsoft_search_window(&st->fs, r);
-    if (!filtsoft_may_block(&st->fs, r, ws)) return 1.0;
+    FsWindow ws;
+    double z_min; /* the search window's nearest depth, linear */
+    if (!filtsoft_search(&st->fs, r, &ws, &z_min)) return 1.0;
     double u = filtsoft_unit(&st->fs, r), z_avg, m[PREFILTER_MAX_CHANNELS];
     if (!cssm_blocker(st, r, ws, u, &z_avg)) return 1.0;
-    FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_avg));
+    FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_avg), z_min);
     if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 2 * st->terms, m)) /* the basis only */
         return NAN;
     return st->scale * step_at(st, m, u - st->offset);

@@ -74,21 +74,24 @@ static double hardened(double x)
 
 static double dpcf_visibility(const DpcfState *st, const SmapReceiver *r, uint32_t sample)
 {
-    FsWindow w = filtsoft_search_window(&st->fs, r);
-    if (!filtsoft_may_block(&st->fs, r, w)) return 1.0;
+    FsWindow w;
+    double z_min;
+    if (!filtsoft_search(&st->fs, r, &w, &z_min)) return 1.0;
+    if (isnan(z_min)) return NAN; /* a NaN depth in reach: no taps to place */
     double cs, sn, depth_sum = 0.0;
     int occluded = 0;
     softmap_rotation(st->rotate, sample, &cs, &sn);
     for (int k = 0; k < st->taps; k++) {
         double px = st->disk->pts[k][0], py = st->disk->pts[k][1];
         int i = (int)floor(r->mc.s + w.hx * (cs * px - sn * py)), j = (int)floor(r->mc.t + w.hy * (sn * px + cs * py));
-        float stored = shadowmap_texel(st->fs.sm.map, r->mc.face, i, j);
-        if (!(smap_ref_at(r, i, j) > stored)) continue;
-        occluded++;
-        depth_sum += smap_linear_depth(st->fs.sm.map, r->mc.face, stored);
+        float stored = shadowmap_texel(st->fs.sm.map, r->mc.face, i, j), lit = smap_test(smap_ref_at(r, i, j), stored);
+        if (lit == 1.0f) continue;
+        occluded++; /* a NaN depth or reference: an unknown tap, its depth NaN (as pcss's blocker_add) */
+        depth_sum += isnan(lit) ? NAN : smap_linear_depth(st->fs.sm.map, r->mc.face, stored);
     }
     if (occluded == 0) return 1.0;
     double z_p = r->mc.depth_linear, z_avg = depth_sum / occluded;
+    if (isnan(z_avg)) return NAN; /* the blockers' depth, hence the ratio, is unknown */
     double ratio = z_avg > 0.0 ? st->ratio_scale * (z_p - z_avg) / z_avg : 1.0; /* a blocker at the light: widest */
     ratio = ratio < 0.0 ? 0.0 : ratio > 1.0 ? 1.0 : ratio;
     double o = (double)occluded / st->taps;

@@ -2,13 +2,19 @@
  * course §4.2.4; Lauritzen & McCool 2008), both windows read from one
  * summed-area table of the four warped moments (course §5.2.2.2), so a
  * receiver costs two lookups at any light size:
- *   1. blocker average: on the positive warp w(u) = e^(c+ (u - 1)) (stored
- *      scaled by e^-c+, prefilter.c), Chebyshev's bound p on the lit
- *      fraction at the receiver's w(d) and Yang et al. 2010's estimate
- *      (VSSM §4) in the warped domain, w_occ = (E w - p w(d)) / (1 - p),
- *      mapped back through the warp: z_occ = 1 + ln(w_occ) / c+ [OWN: the
- *      estimate carried to the exponential moments]. By Jensen's inequality
- *      that is at least the blockers' mean depth, exact for one depth;
+ *   1. blocker average: on the negative warp n(u) = -e^(-c- u),
+ *      Chebyshev's bound q on the lit fraction at the receiver's n(d) and
+ *      Yang et al. 2010's estimate (VSSM §4) in the warped domain,
+ *      n_occ = (E n - q n(d)) / (1 - q), mapped back through the warp:
+ *      z_occ = -ln(-n_occ) / c- [OWN: the estimate carried to the
+ *      exponential moments]. By Jensen's inequality that is at most the
+ *      blockers' mean depth (a wider window), exact for one depth. On the
+ *      negative warp the blockers (u < d) carry the largest |n|, so the
+ *      slack of Chebyshev's bound (a receiver's tilted floor in the window)
+ *      barely moves n_occ; on the positive warp e^(c+ (u - 1)) blockers are
+ *      e^(-c+ gap) below the receiver's own texels and that slack drove
+ *      w_occ to 0: z_occ at the near plane, the widest window, umbrae lit
+ *      (contact.lua 160 x 120: umbra leak 0.51 -> 0.14 [measured]);
  *   2. the filter window from z_occ (course §5.2.2 step 2);
  *   3. EVSM over it: the smaller Chebyshev bound of the two warps
  *      (course §4.2.4, the warp pair erratum: +e^(c+ u), -e^(-c- u)).
@@ -16,6 +22,7 @@
  * (prefilter.h); moments below it (e^(2 c+ (u - 1)) for deep blockers at
  * large c+) are noise, so the exponents default lower than evsm's box blur. */
 #include <stdlib.h>
+#include "core/nanmath.h"
 #include "techniques/filtsoft.h"
 
 enum { P_MAX_RADIUS = SMAP_NUM_DEPTH_BIAS_PARAMS, P_PRECISION, P_CPOS, P_CNEG, P_MIN_VAR, P_LIT_EPS };
@@ -73,35 +80,42 @@ static double positive_bound(const EvssmState *st, const double *m, double u)
     return chebyshev_upper(m[0], m[1], w, st->min_variance * slope * slope);
 }
 
+/* Chebyshev on the negative warp -e^(-c- u) at the receiver, the clamp
+ * scaled by the warp's slope there, as evsm's. */
+static double negative_bound(const EvssmState *st, const double *m, double u)
+{
+    double w = exp(-st->c_neg * u), slope = st->c_neg * w;
+    return chebyshev_upper(m[2], m[3], -w, st->min_variance * slope * slope);
+}
+
 /* course §4.2.4: p = min(p+, p-). */
 static double evsm_bound(const EvssmState *st, const double *m, double u)
 {
-    double p = positive_bound(st, m, u);
-    double w = exp(-st->c_neg * u), slope = st->c_neg * w;
-    double q = chebyshev_upper(m[2], m[3], -w, st->min_variance * slope * slope);
-    return q < p ? q : p;
+    return nan_min(positive_bound(st, m, u), negative_bound(st, m, u));
 }
 
-/* Step 1: the blockers' normalised depth; false: lit. */
+/* Step 1: the blockers' normalised depth from the negative warp; false: lit. */
 static bool evssm_blocker(const EvssmState *st, const double *m, double u, double *z_occ)
 {
-    double w_occ;
-    if (!filtsoft_blocker_mean(m[0], positive_bound(st, m, u), exp(st->c_pos * (u - 1.0)), st->lit_eps, &w_occ))
+    double n_occ;
+    if (!filtsoft_blocker_mean(m[2], negative_bound(st, m, u), -exp(-st->c_neg * u), st->lit_eps, &n_occ))
         return false;
-    /* w_occ <= 0 is rounding below the smallest moment: blockers at the near plane (NaN passes on) */
-    double z = w_occ > 0.0 ? 1.0 + log(w_occ) / st->c_pos : w_occ <= 0.0 ? 0.0 : w_occ;
-    *z_occ = z < 0.0 ? 0.0 : z > u ? u : z;
+    /* e_occ = e^(-c- z_occ); e_occ <= 0 is rounding below the receiver's own moment: blockers at the receiver
+     * (a NaN passes on) */
+    double e_occ = -n_occ, z = e_occ > 0.0 ? -log(e_occ) / st->c_neg : e_occ <= 0.0 ? u : e_occ;
+    *z_occ = nan_clamp(z, 0.0, u);
     return true;
 }
 
 static double evssm_visibility(const EvssmState *st, const SmapReceiver *r)
 {
-    FsWindow ws = filtsoft_search_window(&st->fs, r);
-    if (!filtsoft_may_block(&st->fs, r, ws)) return 1.0;
+    FsWindow ws;
+    double z_min; /* the search window's nearest depth, linear */
+    if (!filtsoft_search(&st->fs, r, &ws, &z_min)) return 1.0;
     double u = filtsoft_unit(&st->fs, r), m[4], z_occ;
     if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, ws.hx, ws.hy, 4, m)) return NAN; /* a NaN window */
     if (!evssm_blocker(st, m, u, &z_occ)) return 1.0;
-    FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_occ));
+    FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_occ), z_min);
     if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 4, m)) return NAN;
     return evsm_bound(st, m, u);
 }

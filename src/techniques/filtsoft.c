@@ -1,6 +1,7 @@
 /* filtsoft.c -- PCSS's windows and the prefiltered maps the constant-time
  * soft shadows read (filtsoft.h; course §5.2.2, §5.2.2.2). */
 #include "techniques/filtsoft.h"
+#include "core/nanmath.h"
 
 bool filtsoft_init(FiltSoft *fs, const TechContext *ctx, double max_radius, bool receiver_plane, const char *tech,
                    Error *err)
@@ -29,26 +30,40 @@ static FsWindow window(const FiltSoft *fs, const SoftFace *f, double k)
     return w;
 }
 
-FsWindow filtsoft_search_window(const FiltSoft *fs, const SmapReceiver *r)
-{
-    const SoftFace *f = &fs->sm.face[r->mc.face];
-    double z_p = r->mc.depth_linear, z_n = f->near_world;
-    return window(fs, f, (z_p - z_n) / (z_p * z_n)); /* course §5.2.2 step 1, per unit of light half-extent */
-}
-
-FsWindow filtsoft_filter_window(const FiltSoft *fs, const SmapReceiver *r, double z_avg)
-{
-    const SoftFace *f = &fs->sm.face[r->mc.face];
-    double z_p = r->mc.depth_linear, z_n = f->near_world;
-    /* d_blocker -> 0 (course §5.2.2.1, [OWN] degenerate inputs): blockers lie beyond the near plane */
-    z_avg = z_avg < z_n ? z_n : z_avg > z_p ? z_p : z_avg;
-    return window(fs, f, (z_p - z_avg) / (z_avg * z_p)); /* course §5.2.2 step 2 */
-}
-
-bool filtsoft_may_block(const FiltSoft *fs, const SmapReceiver *r, FsWindow w)
+static bool may_block(const FiltSoft *fs, const SmapReceiver *r, FsWindow w, double *z_min_linear)
 {
     return softmap_may_block(&fs->sm, r, (int)floor(r->mc.s - w.hx), (int)floor(r->mc.t - w.hy),
-                             (int)floor(r->mc.s + w.hx), (int)floor(r->mc.t + w.hy), NULL);
+                             (int)floor(r->mc.s + w.hx), (int)floor(r->mc.t + w.hy), z_min_linear);
+}
+
+bool filtsoft_search(const FiltSoft *fs, const SmapReceiver *r, FsWindow *w, double *z_min)
+{
+    const SoftFace *f = &fs->sm.face[r->mc.face];
+    double z_p = r->mc.depth_linear, z_cut = f->near_world;
+    for (int pass = 0; pass < 3; pass++) {
+        *w = window(fs, f, (z_p - z_cut) / (z_p * z_cut)); /* course §5.2.2 step 1, per unit of light half-extent */
+        if (pass == 2) break;
+        double z;
+        if (!may_block(fs, r, *w, &z)) return false;
+        z_cut = nan_max(z_cut, z);
+        if (isnan(z_cut)) { /* a NaN depth in reach: the window is unknown */
+            *w = (FsWindow){NAN, NAN};
+            break;
+        }
+    }
+    *z_min = z_cut;
+    return true;
+}
+
+FsWindow filtsoft_filter_window(const FiltSoft *fs, const SmapReceiver *r, double z_avg, double z_min)
+{
+    const SoftFace *f = &fs->sm.face[r->mc.face];
+    double z_p = r->mc.depth_linear, z_lo = z_min > f->near_world ? z_min : f->near_world;
+    /* d_blocker -> 0 (course §5.2.2.1, [OWN] degenerate inputs): blockers lie beyond the near plane and no
+     * nearer than the window's nearest texel; a moment estimate below it (Chebyshev's bound over a window
+     * whose receiver spans depths, [OWN]) would otherwise take the widest window there */
+    z_avg = z_avg < z_lo ? z_lo : z_avg > z_p ? z_p : z_avg;
+    return window(fs, f, (z_p - z_avg) / (z_avg * z_p)); /* course §5.2.2 step 2 */
 }
 
 double filtsoft_unit(const FiltSoft *fs, const SmapReceiver *r)

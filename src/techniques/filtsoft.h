@@ -3,7 +3,8 @@
  * distance-based PCF): PCSS's geometry (course §5.2.2, pcss.c) in a map
  * face's tangent frame (softmap.h) and the windows it sets, in texels:
  *   search half-width a (z_p - z_n) / (z_p z_n) / dx (the light-receiver
- *   pyramid on the near plane z_n),
+ *   pyramid on the near plane z_n, then on the window's nearest depth,
+ *   course §5.2.3.4's search area through z_min: filtsoft_search),
  *   filter half-width a (z_p - z_avg) / (z_avg z_p) / dx (w_f = w_penumbra
  *   z_n / z_p with w_penumbra = (z_p - z_avg) / z_avg w_light),
  * both clamped to [1/2, max_radius] texels (sub-texel kernels alias; the
@@ -50,12 +51,21 @@ bool filtsoft_init(FiltSoft *fs, const TechContext *ctx, double max_radius, bool
 /* A window about the receiver: half-widths in texels. */
 typedef struct FsWindow { double hx, hy; } FsWindow;
 
-FsWindow filtsoft_search_window(const FiltSoft *fs, const SmapReceiver *r);
-/* z_avg: the average blocker depth, linear; clamped to [z_n, z_p] first. */
-FsWindow filtsoft_filter_window(const FiltSoft *fs, const SmapReceiver *r, double z_avg);
-/* false when no texel of the window can block the receiver (the min-max
- * pyramid's exact test, softmap_may_block): lit, without a fetch. */
-bool filtsoft_may_block(const FiltSoft *fs, const SmapReceiver *r, FsWindow w);
+/* The blocker search window *w and *z_min, a lower bound of every depth in
+ * it (linear): the light-receiver pyramid cut at the near plane, then twice
+ * at the nearest depth the min-max pyramid finds in the window so far
+ * (course §5.2.3.4, as brabec's outer_limit). Exact: a blocker lies in the
+ * window and beyond its nearest depth, so within the pyramid's cut there.
+ * The near plane alone, on a map fitted to a large scene, gave the widest
+ * window at every contact (the moments then mixed the receiver's own tilted
+ * floor, 62 texels of it, into the blocker estimate: umbrae lit). false:
+ * nothing in reach can block (lit, without a fetch). A NaN depth in reach
+ * gives a NaN window and *z_min. */
+bool filtsoft_search(const FiltSoft *fs, const SmapReceiver *r, FsWindow *w, double *z_min);
+/* z_avg: the average blocker depth, linear; clamped first to [z_min, z_p],
+ * z_min filtsoft_search's: a mean of the blockers cannot lie nearer than
+ * the nearest of them. */
+FsWindow filtsoft_filter_window(const FiltSoft *fs, const SmapReceiver *r, double z_avg, double z_min);
 
 /* The receiver's normalised reference depth u in [0, 1] (prefilter.h). */
 double filtsoft_unit(const FiltSoft *fs, const SmapReceiver *r);

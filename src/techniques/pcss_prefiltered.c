@@ -66,14 +66,15 @@ static bool pp_prepare(const TechContext *ctx, void **state, Error *err)
 
 static double pp_visibility(const PpState *st, const SmapReceiver *r)
 {
-    FsWindow ws = filtsoft_search_window(&st->fs, r);
-    if (!filtsoft_may_block(&st->fs, r, ws)) return 1.0;
+    FsWindow ws;
+    double z_min; /* the search window's nearest depth, linear */
+    if (!filtsoft_search(&st->fs, r, &ws, &z_min)) return 1.0;
     double u = filtsoft_unit(&st->fs, r), m[2], z_occ;
     if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, ws.hx, ws.hy, 2, m)) return NAN; /* a NaN window */
     double p_search = chebyshev_upper(m[0], m[1], u, st->min_variance);
     if (!filtsoft_blocker_mean(m[0], p_search, u, st->lit_eps, &z_occ)) return 1.0;
     z_occ = filtsoft_unit_clamp(z_occ); /* mu_s and u lie in [0, 1]: rounding only */
-    FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_occ));
+    FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_occ), z_min);
     if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 2, m)) return NAN;
     return chebyshev_upper(m[0], m[1], u, st->min_variance);
 }
