@@ -154,11 +154,17 @@ for t in pairs(off_default) do sl.technique(t) end -- an unknown name is an erro
 
 local result = exp:run(args)
 
+-- A view with no umbra (a region absent from the record: null) has no umbra
+-- leak to judge.
 local function verdict(tech, scene, leak)
+  if type(leak) ~= "number" then return "no umbra", nil end
   local why = EXPECTED[tech] and (EXPECTED[tech][scene] or EXPECTED[tech]["*"])
   if not (leak <= LEAK_LIMIT) then return why and "expected leak" or "UNEXPECTED leak", why end
   return "ok", nil
 end
+
+-- A statistic of a region, "-" where the region is absent (null).
+local function stat(v) return type(v) == "number" and string.format("%.4f", v) or "-" end
 
 local lines = { "| technique | scene | RMSE | penumbra RMSE | umbra leak | verdict |", "|---|---|---|---|---|---|" }
 local reasons, unexpected, failed = {}, 0, 0
@@ -172,8 +178,8 @@ for _, row in ipairs(result.rows) do
     local v, why = verdict(row.technique, scene, m.umbra.leak_mean)
     if v == "UNEXPECTED leak" then unexpected = unexpected + 1 end
     if why then reasons[row.technique .. " on " .. scene] = why end
-    lines[#lines + 1] = string.format("| `%s` | %s | %.4f | %.4f | %.4f | %s |", row.label, scene, m.all.rmse,
-                                      m.penumbra.rmse, m.umbra.leak_mean, v)
+    lines[#lines + 1] = string.format("| `%s` | %s | %s | %s | %s | %s |", row.label, scene, stat(m.all.rmse),
+                                      stat(m.penumbra.rmse), stat(m.umbra.leak_mean), v)
   end
 end
 local keys = {}
