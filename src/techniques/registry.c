@@ -26,6 +26,7 @@ extern const Technique tech_backprojection;
 extern const Technique tech_light_sampling;
 extern const Technique tech_occlusion_textures;
 extern const Technique tech_shadow_volume;
+extern const Technique tech_depth_complexity;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -48,6 +49,7 @@ static const Technique *const registry[] = {
     &tech_light_sampling,
     &tech_occlusion_textures,
     &tech_shadow_volume,
+    &tech_depth_complexity,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }
