@@ -76,53 +76,76 @@ static const char *const dc_aux[] = {"near_edge", NULL};
 
 #define CHUNK 32 /* triangles per bounding sphere */
 
+/* A bounding sphere (world space). */
+typedef struct Ball {
+    dvec3 centre;
+    double radius;
+} Ball;
+
+/* Caster triangles in chunks of at most CHUNK, each within one object. */
 typedef struct DcState {
     RTCScene rtc;
     float extent;
-    int num_tris;
-    vec3 *tri;      /* caster triangles, world space, 3 corners each */
-    dvec3 *centre;  /* per chunk of CHUNK consecutive triangles: a bounding sphere */
-    double *radius;
+    int num_tris, num_chunks, num_objects;
+    vec3 *tri;         /* caster triangles, world space, 3 corners each */
+    int *chunk_first;  /* per chunk: its first triangle; num_chunks + 1 */
+    Ball *chunk_ball;
+    int *object_first; /* per caster object: its first chunk; num_objects + 1 */
+    Ball *object_ball;
 } DcState;
 
-/* A bounding sphere of each chunk: its corners' box centre, the farthest corner. */
-static void bound_chunks(DcState *st)
+/* A sphere around corners [first, last): their box's centre, the farthest corner. */
+static Ball bound_corners(const vec3 *p, int first, int last)
 {
-    for (int c = 0; c * CHUNK < st->num_tris; c++) {
-        int first = 3 * c * CHUNK, last = 3 * (c * CHUNK + CHUNK < st->num_tris ? c * CHUNK + CHUNK : st->num_tris);
-        vec3 lo = st->tri[first], hi = lo;
-        for (int k = first; k < last; k++) {
-            lo = v3_min(lo, st->tri[k]);
-            hi = v3_max(hi, st->tri[k]);
-        }
-        dvec3 m = d3_scale(d3_add(d3_from(lo), d3_from(hi)), 0.5);
-        double r = 0.0;
-        for (int k = first; k < last; k++) r = fmax(r, d3_len(d3_sub(d3_from(st->tri[k]), m)));
-        st->centre[c] = m;
-        st->radius[c] = r * (1.0 + 1e-6);
+    vec3 lo = p[first], hi = lo;
+    for (int k = first; k < last; k++) {
+        lo = v3_min(lo, p[k]);
+        hi = v3_max(hi, p[k]);
     }
+    Ball b = {d3_scale(d3_add(d3_from(lo), d3_from(hi)), 0.5), 0.0};
+    for (int k = first; k < last; k++) b.radius = fmax(b.radius, d3_len(d3_sub(d3_from(p[k]), b.centre)));
+    b.radius *= 1.0 + 1e-6;
+    return b;
+}
+
+static bool alloc_casters(DcState *st, long tris, long chunks, int objects)
+{
+    st->tri = malloc(sizeof *st->tri * 3 * (size_t)(tris + 1));
+    st->chunk_first = malloc(sizeof *st->chunk_first * (size_t)(chunks + 1));
+    st->chunk_ball = malloc(sizeof *st->chunk_ball * (size_t)(chunks + 1));
+    st->object_first = malloc(sizeof *st->object_first * (size_t)(objects + 1));
+    st->object_ball = malloc(sizeof *st->object_ball * (size_t)(objects + 1));
+    return st->tri && st->chunk_first && st->chunk_ball && st->object_first && st->object_ball;
 }
 
 static bool collect_casters(const Scene *scene, DcState *st, Error *err)
 {
-    long n = 0;
-    for (int i = 0; i < scene->num_objects; i++)
-        if (scene->objects[i].caster) n += scene->objects[i].mesh.num_triangles;
+    long n = 0, chunks = 0;
+    int objects = 0;
+    for (int i = 0; i < scene->num_objects; i++) {
+        int t = scene->objects[i].mesh.num_triangles;
+        if (!scene->objects[i].caster || t == 0) continue;
+        n += t;
+        chunks += (t + CHUNK - 1) / CHUNK;
+        objects++;
+    }
     if (n > INT32_MAX / 3) return error_set(err, "depth_complexity: %ld caster triangles (at most %d)", n, INT32_MAX / 3);
-    st->tri = malloc(sizeof *st->tri * 3 * (size_t)(n + 1));
-    if (!st->tri) return error_set(err, "out of memory for %ld caster triangles", n);
-    size_t chunks = (size_t)(n / CHUNK + 1);
-    st->centre = malloc(sizeof *st->centre * chunks);
-    st->radius = malloc(sizeof *st->radius * chunks);
-    if (!st->centre || !st->radius) return error_set(err, "out of memory for %ld caster triangles", n);
-    st->num_tris = 0;
+    if (!alloc_casters(st, n, chunks, objects)) return error_set(err, "out of memory for %ld caster triangles", n);
     for (int i = 0; i < scene->num_objects; i++) {
         const Mesh *m = &scene->objects[i].mesh;
-        if (!scene->objects[i].caster) continue;
-        for (int t = 0; t < m->num_triangles; t++, st->num_tris++)
+        if (!scene->objects[i].caster || m->num_triangles == 0) continue;
+        int first = st->num_tris;
+        st->object_first[st->num_objects] = st->num_chunks;
+        for (int t = 0; t < m->num_triangles; t++, st->num_tris++) {
+            if (t % CHUNK == 0) st->chunk_first[st->num_chunks++] = st->num_tris;
             for (int k = 0; k < 3; k++) st->tri[3 * st->num_tris + k] = m->positions[m->indices[3 * t + k]];
+        }
+        st->object_ball[st->num_objects++] = bound_corners(st->tri, 3 * first, 3 * st->num_tris);
     }
-    bound_chunks(st);
+    st->chunk_first[st->num_chunks] = st->num_tris;
+    st->object_first[st->num_objects] = st->num_chunks;
+    for (int c = 0; c < st->num_chunks; c++)
+        st->chunk_ball[c] = bound_corners(st->tri, 3 * st->chunk_first[c], 3 * st->chunk_first[c + 1]);
     return true;
 }
 
@@ -131,8 +154,10 @@ static void dc_release(void *state)
     DcState *st = state;
     if (!st) return;
     free(st->tri);
-    free(st->centre);
-    free(st->radius);
+    free(st->chunk_first);
+    free(st->chunk_ball);
+    free(st->object_first);
+    free(st->object_ball);
     free(st);
 }
 
@@ -301,15 +326,61 @@ static Frame frame_at(const TechContext *ctx, vec3 org, vec3 p)
     return f;
 }
 
-/* Can chunk c reach the cone from org around c holding the light samples
- * (cosine cos_cone)? The sphere subtends asin(r / |m - org|) about m - org. */
-static bool chunk_in_cone(const DcState *st, int c, const Frame *f, double cos_cone)
+/* Can ball b reach the cone from org around f->c of half-angle acos(cos_cone)?
+ * The ball subtends asin(r / |m - org|) about m - org. */
+static bool ball_in_cone(const Ball *b, const Frame *f, double cos_cone)
 {
-    dvec3 w = d3_sub(st->centre[c], f->org);
-    double dist = d3_len(w), r = st->radius[c];
-    if (dist <= r) return true;
+    dvec3 w = d3_sub(b->centre, f->org);
+    double dist = d3_len(w);
+    if (dist <= b->radius) return true;
     double axis = acos(fmax(-1.0, fmin(1.0, d3_dot(w, f->c) / dist)));
-    return axis - asin(r / dist) <= acos(fmax(-1.0, fmin(1.0, cos_cone))) + 1e-9;
+    return axis - asin(b->radius / dist) <= acos(fmax(-1.0, fmin(1.0, cos_cone))) + 1e-9;
+}
+
+/* The cosine of the cone from org around the light's centre holding the
+ * whole light (its bounding sphere): every light sample lies inside. */
+static double light_cone(const Ball *light, const Frame *f)
+{
+    double r = light->radius, dist = d3_len(d3_sub(light->centre, f->org));
+    return dist <= r ? -1.0 : sqrt(1.0 - (r / dist) * (r / dist));
+}
+
+static Ball light_ball(const Light *l)
+{
+    double r = l->kind == LIGHT_RECT ? 0.5 * hypot(l->width, l->height) : l->radius;
+    return (Ball){d3_from(l->position), r * (1.0 + 1e-6)};
+}
+
+/* Are org and the whole light (ball) strictly on one side of triangle t's
+ * plane? Then their convex hull, which holds every segment toward a light
+ * sample, misses it (a receiver's own ground under a light above it). */
+static bool plane_separates(const vec3 *t, const Frame *f, const Ball *light)
+{
+    dvec3 a = d3_from(t[0]), n = d3_cross(d3_sub(d3_from(t[1]), a), d3_sub(d3_from(t[2]), a));
+    double len = d3_len(n);
+    if (!(len > 0.0)) return true; /* zero area: blocks nothing */
+    double so = d3_dot(n, d3_sub(f->org, a)), sc = d3_dot(n, d3_sub(light->centre, a));
+    return (so > 0.0 && sc > light->radius * len) || (so < 0.0 && sc < -light->radius * len);
+}
+
+/* Does any caster triangle reach the cone? With counts: add them all. */
+static bool add_casters(const DcState *st, Samples *sm, const Frame *f, const Ball *light, double cos_cone, P2 r,
+                        bool add)
+{
+    bool any = false;
+    for (int o = 0; o < st->num_objects; o++) {
+        if (!ball_in_cone(&st->object_ball[o], f, cos_cone)) continue;
+        for (int c = st->object_first[o]; c < st->object_first[o + 1]; c++) {
+            if (!ball_in_cone(&st->chunk_ball[c], f, cos_cone)) continue;
+            for (int t = st->chunk_first[c]; t < st->chunk_first[c + 1]; t++) {
+                if (plane_separates(&st->tri[3 * t], f, light)) continue;
+                if (!add) return true;
+                any = true;
+                add_triangle(sm, f, &st->tri[3 * t], r);
+            }
+        }
+    }
+    return any;
 }
 
 /* Visibility of one view sample; *near counts its ambiguous light samples. */
@@ -318,8 +389,11 @@ static float sample_visibility(const DcState *st, const TechContext *ctx, int s,
     vec3 p = ctx->vs->p_world[s], ng = ctx->vs->n_geom_world[s];
     vec3 org = v3_madd(p, ng, rt_ray_offset(st->extent, p));
     Frame f = frame_at(ctx, org, p);
-    draw_samples(sm, ctx, s, &f);
     *near = 0;
+    Ball light = light_ball(ctx->light);
+    if (!add_casters(st, NULL, &f, &light, light_cone(&light, &f), (P2){0, 0}, false))
+        return 1.0f; /* no caster reaches the light's cone: every ray the reference traces is unblocked */
+    draw_samples(sm, ctx, s, &f);
     if (sm->kept == 0) { /* a sliver above the horizon: the reference's one ray */
         LightSample hi = light_sample_highest(ctx->light, p, ng);
         return occluded(st->rtc, org, &hi) ? 0.0f : 1.0f;
@@ -327,11 +401,7 @@ static float sample_visibility(const DcState *st, const TechContext *ctx, int s,
     int first = 0;
     while (!sm->above[first]) first++;
     P2 r = sm->x[first]; /* counters relative to the first kept sample */
-    for (int c = 0; c * CHUNK < st->num_tris; c++) {
-        if (!chunk_in_cone(st, c, &f, sm->cos_cone)) continue;
-        int last = c * CHUNK + CHUNK < st->num_tris ? c * CHUNK + CHUNK : st->num_tris;
-        for (int t = c * CHUNK; t < last; t++) add_triangle(sm, &f, &st->tri[3 * t], r);
-    }
+    add_casters(st, sm, &f, &light, sm->cos_cone, r, true);
     int best = first;
     for (int i = first; i < sm->n; i++)
         if (sm->above[i] && sm->rel[i] < sm->rel[best]) best = i;
