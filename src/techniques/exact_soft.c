@@ -133,6 +133,16 @@ void exact_for_casters(const ExactCasters *c, const LightPoints *lp, ExactTriang
     visit_casters(c, &lp->f, &lp->light, lp->cos_cone, fn, user);
 }
 
+bool exact_chunk_reaches(const ExactCasters *c, int k, const LightPoints *lp)
+{
+    return ball_in_cone(&c->chunk_ball[k], &lp->f, lp->cos_cone);
+}
+
+bool exact_triangle_reaches(const ExactCasters *c, int t, const LightPoints *lp)
+{
+    return !plane_separates(&c->tri[3 * t], &lp->f, &lp->light);
+}
+
 static Ball light_ball(const Light *l)
 {
     double r = l->kind == LIGHT_RECT ? 0.5 * hypot(l->width, l->height) : l->radius;

@@ -110,6 +110,10 @@ float exact_sliver_visibility(const ExactCasters *c, const TechContext *ctx, int
  * each triangle against org and the light). */
 typedef void (*ExactTriangleFn)(void *user, const vec3 *tri);
 void exact_for_casters(const ExactCasters *c, const LightPoints *lp, ExactTriangleFn fn, void *user);
+/* The same tests one at a time: can chunk k reach the samples' cone, can
+ * triangle t (a chunk's) block a segment toward the light at all? */
+bool exact_chunk_reaches(const ExactCasters *c, int k, const LightPoints *lp);
+bool exact_triangle_reaches(const ExactCasters *c, int t, const LightPoints *lp);
 
 /* Triangle t (world) relative to org, clipped to d.c >= EXACT_CLIP_EPS
  * (Sutherland-Hodgman; each crossing point computed from the edge's inside

@@ -27,6 +27,7 @@ extern const Technique tech_light_sampling;
 extern const Technique tech_occlusion_textures;
 extern const Technique tech_shadow_volume;
 extern const Technique tech_depth_complexity;
+extern const Technique tech_view_sample_mapping;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -50,6 +51,7 @@ static const Technique *const registry[] = {
     &tech_occlusion_textures,
     &tech_shadow_volume,
     &tech_depth_complexity,
+    &tech_view_sample_mapping,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }
