@@ -133,6 +133,11 @@ void exact_for_casters(const ExactCasters *c, const LightPoints *lp, ExactTriang
     visit_casters(c, &lp->f, &lp->light, lp->cos_cone, fn, user);
 }
 
+bool exact_object_reaches(const ExactCasters *c, int o, const LightPoints *lp)
+{
+    return ball_in_cone(&c->object_ball[o], &lp->f, lp->cos_cone);
+}
+
 bool exact_chunk_reaches(const ExactCasters *c, int k, const LightPoints *lp)
 {
     return ball_in_cone(&c->chunk_ball[k], &lp->f, lp->cos_cone);

@@ -110,8 +110,9 @@ float exact_sliver_visibility(const ExactCasters *c, const TechContext *ctx, int
  * each triangle against org and the light). */
 typedef void (*ExactTriangleFn)(void *user, const vec3 *tri);
 void exact_for_casters(const ExactCasters *c, const LightPoints *lp, ExactTriangleFn fn, void *user);
-/* The same tests one at a time: can chunk k reach the samples' cone, can
- * triangle t (a chunk's) block a segment toward the light at all? */
+/* The same tests one at a time: can caster object o or chunk k reach the
+ * samples' cone, can triangle t block a segment toward the light at all? */
+bool exact_object_reaches(const ExactCasters *c, int o, const LightPoints *lp);
 bool exact_chunk_reaches(const ExactCasters *c, int k, const LightPoints *lp);
 bool exact_triangle_reaches(const ExactCasters *c, int t, const LightPoints *lp);
 

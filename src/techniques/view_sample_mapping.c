@@ -95,7 +95,14 @@ static void map_triangle(Mapped *m, const vec3 *tri)
     if (np < 3 || facing == 0) return; /* nothing in front, or edge-on: it hides no sample */
     P2 q[4];
     double area = 0.0;
-    for (int k = 0; k < np; k++) q[k] = exact_project(&m->lp.f, poly[k]);
+    P2 lo = {INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY};
+    for (int k = 0; k < np; k++) {
+        q[k] = exact_project(&m->lp.f, poly[k]);
+        lo = (P2){fmin(lo.x, q[k].x), fmin(lo.y, q[k].y)};
+        hi = (P2){fmax(hi.x, q[k].x), fmax(hi.y, q[k].y)};
+    }
+    const LightPoints *lp = &m->lp;
+    if (hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y) return; /* misses every sample */
     for (int k = 1; k + 1 < np; k++) area += exact_orient(q[0], q[k], q[k + 1]);
     if (area == 0.0) return;
     hide_samples(m, q, np, area > 0.0 ? 1.0 : -1.0);
@@ -119,13 +126,18 @@ static void map_tile(const ExactCasters *cs, const TechContext *ctx, Mapped *til
         m->reached = exact_begin(cs, ctx, m->s, &m->lp);
         if (m->reached) exact_draw(&m->lp, ctx, m->s);
     }
-    for (int c = 0; c < cs->num_chunks; c++)
-        for (int k = 0; k < count; k++) {
-            Mapped *m = &tile[k];
-            if (!m->reached || m->lp.kept == 0 || !exact_chunk_reaches(cs, c, &m->lp)) continue;
-            for (int t = cs->chunk_first[c]; t < cs->chunk_first[c + 1]; t++)
-                if (exact_triangle_reaches(cs, t, &m->lp)) map_triangle(m, &cs->tri[3 * t]);
-        }
+    bool in[TILE];
+    for (int o = 0; o < cs->num_objects; o++) {
+        for (int k = 0; k < count; k++)
+            in[k] = tile[k].reached && tile[k].lp.kept > 0 && exact_object_reaches(cs, o, &tile[k].lp);
+        for (int c = cs->object_first[o]; c < cs->object_first[o + 1]; c++)
+            for (int k = 0; k < count; k++) {
+                Mapped *m = &tile[k];
+                if (!in[k] || !exact_chunk_reaches(cs, c, &m->lp)) continue;
+                for (int t = cs->chunk_first[c]; t < cs->chunk_first[c + 1]; t++)
+                    if (exact_triangle_reaches(cs, t, &m->lp)) map_triangle(m, &cs->tri[3 * t]);
+            }
+    }
     for (int k = 0; k < count; k++) {
         Mapped *m = &tile[k];
         const LightPoints *lp = &m->lp;
