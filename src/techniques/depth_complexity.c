@@ -43,7 +43,7 @@ static const ParamDesc dc_params[] = {
                         "reference's --samples gives the same points"),
 };
 
-static const char *const dc_resources[] = {"embree_bvh", NULL};
+static const char *const dc_resources[] = {"embree_bvh", "silhouette", NULL};
 static const char *const dc_aux[] = {"near_edge", NULL};
 
 /* Laine's counters for one view sample. */

@@ -3,6 +3,7 @@
 #include "techniques/exact_soft.h"
 #include <math.h>
 #include <stdlib.h>
+#include "resources/silhouette.h"
 #include "resources/standard.h"
 
 const char *const exact_pattern_names[] = {"r2", "stratified", "random", NULL}; /* SamplingPattern order */
@@ -28,10 +29,18 @@ static bool alloc_casters(ExactCasters *c, long tris, long chunks, int objects)
     c->chunk_ball = malloc(sizeof *c->chunk_ball * (size_t)(chunks + 1));
     c->object_first = malloc(sizeof *c->object_first * (size_t)(objects + 1));
     c->object_ball = malloc(sizeof *c->object_ball * (size_t)(objects + 1));
-    return c->tri && c->chunk_first && c->chunk_ball && c->object_first && c->object_ball;
+    c->object_closed = calloc((size_t)objects + 1, sizeof *c->object_closed);
+    return c->tri && c->chunk_first && c->chunk_ball && c->object_first && c->object_ball && c->object_closed;
 }
 
-static bool collect_casters(const Scene *scene, ExactCasters *c, Error *err)
+static bool object_closed(const Silhouette *sil, int object)
+{
+    for (int i = 0; i < sil->num_objects; i++)
+        if (sil->objects[i].object == object) return sil->objects[i].closed;
+    return false;
+}
+
+static bool collect_casters(const Scene *scene, const Silhouette *sil, ExactCasters *c, Error *err)
 {
     long n = 0, chunks = 0;
     int objects = 0;
@@ -53,6 +62,7 @@ static bool collect_casters(const Scene *scene, ExactCasters *c, Error *err)
             if (t % EXACT_CHUNK == 0) c->chunk_first[c->num_chunks++] = c->num_tris;
             for (int k = 0; k < 3; k++) c->tri[3 * c->num_tris + k] = m->positions[m->indices[3 * t + k]];
         }
+        c->object_closed[c->num_objects] = object_closed(sil, i);
         c->object_ball[c->num_objects++] = bound_corners(c->tri, 3 * first, 3 * c->num_tris);
     }
     c->chunk_first[c->num_chunks] = c->num_tris;
@@ -69,6 +79,7 @@ void exact_casters_free(ExactCasters *c)
     free(c->chunk_ball);
     free(c->object_first);
     free(c->object_ball);
+    free(c->object_closed);
 }
 
 bool exact_casters_init(const TechContext *ctx, ExactCasters *c, Error *err)
@@ -78,9 +89,11 @@ bool exact_casters_init(const TechContext *ctx, ExactCasters *c, Error *err)
         return false;
     const RtScene *bvh = res_bvh(ctx->rm, ctx->scene, RT_CASTERS, err);
     if (!bvh) return false;
+    const Silhouette *sil = res_silhouette(ctx->rm, ctx->scene, ctx->light_index, err);
+    if (!sil) return false;
     c->rtc = rt_scene_handle(bvh);
     c->extent = scene_extent(ctx->scene);
-    if (collect_casters(ctx->scene, c, err)) return true;
+    if (collect_casters(ctx->scene, sil, c, err)) return true;
     exact_casters_free(c);
     return false;
 }
@@ -136,6 +149,11 @@ void exact_for_casters(const ExactCasters *c, const LightPoints *lp, ExactTriang
 bool exact_object_reaches(const ExactCasters *c, int o, const LightPoints *lp)
 {
     return ball_in_cone(&c->object_ball[o], &lp->f, lp->cos_cone);
+}
+
+bool exact_front_faces_suffice(const ExactCasters *c, int o, const LightPoints *lp)
+{
+    return c->object_closed[o] && d3_len(d3_sub(c->object_ball[o].centre, lp->f.org)) > c->object_ball[o].radius;
 }
 
 bool exact_chunk_reaches(const ExactCasters *c, int k, const LightPoints *lp)

@@ -56,9 +56,11 @@ typedef struct ExactCasters {
     Ball *chunk_ball;
     int *object_first; /* per caster object: its first chunk; num_objects + 1 */
     Ball *object_ball;
+    bool *object_closed; /* a closed 2-manifold (resources/silhouette.h's adjacency) */
 } ExactCasters;
 
-/* Checks the sample parameters, acquires the casters' BVH and gathers them. */
+/* Checks the sample parameters, acquires the casters' BVH and their
+ * silhouette resource (for each object's closedness) and gathers them. */
 bool exact_casters_init(const TechContext *ctx, ExactCasters *c, Error *err);
 void exact_casters_free(ExactCasters *c);
 
@@ -115,6 +117,10 @@ void exact_for_casters(const ExactCasters *c, const LightPoints *lp, ExactTriang
 bool exact_object_reaches(const ExactCasters *c, int o, const LightPoints *lp);
 bool exact_chunk_reaches(const ExactCasters *c, int k, const LightPoints *lp);
 bool exact_triangle_reaches(const ExactCasters *c, int t, const LightPoints *lp);
+/* May object o's back faces (from org) be skipped? On a closed object with
+ * org outside its bounding sphere, a segment that crosses a back face
+ * crossed a front face first. */
+bool exact_front_faces_suffice(const ExactCasters *c, int o, const LightPoints *lp);
 
 /* Triangle t (world) relative to org, clipped to d.c >= EXACT_CLIP_EPS
  * (Sutherland-Hodgman; each crossing point computed from the edge's inside
