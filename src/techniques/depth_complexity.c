@@ -19,7 +19,9 @@
  * cancel exactly (the crossing predicate is evaluated on the edge's
  * canonical endpoint order) and an open edge steps once: Laine's per-edge
  * update with the edge's multiplicity, summed over the triangles that carry
- * it. Crossing into a front-facing triangle's projection raises D by 1.
+ * it. Crossing into a front-facing triangle's projection raises D by 1. A
+ * closed caster (silhouette.h) seen from outside its bounding sphere counts
+ * its front faces only: D halves there, and is 0 where it was.
  *
  * The constant (Laine et al. 2005 §3.2; catalogue: "one reference ray toward
  * a sample away from all projected edges"): the reference sample is the one
@@ -94,11 +96,15 @@ static void add_edge(Counters *k, dvec3 a, dvec3 b, int w)
     }
 }
 
-static void add_triangle(void *user, const vec3 *tri)
+/* On a closed object seen from outside, a segment crosses as many back
+ * faces as front faces, so counting the front faces alone (front_only: their
+ * region's boundary is the silhouette, each edge stepping once) leaves D = 0
+ * exactly where it was: the visibility does not change. */
+static void add_triangle(void *user, const vec3 *tri, bool front_only)
 {
     dvec3 poly[4];
     int w, np = exact_clip(&((Counters *)user)->lp.f, tri, poly, &w);
-    if (w == 0) return; /* edge-on from org: it blocks no segment */
+    if (w == 0 || (front_only && w < 0)) return; /* edge-on from org: it blocks no segment */
     for (int k = 0; k < np; k++) add_edge(user, poly[k], poly[(k + 1) % np], w);
 }
 

@@ -121,6 +121,11 @@ static bool plane_separates(const vec3 *t, const Frame *f, const Ball *light)
     return (so > 0.0 && sc > light->radius * len) || (so < 0.0 && sc < -light->radius * len);
 }
 
+static bool outside_closed(const ExactCasters *c, int o, const Frame *f)
+{
+    return c->object_closed[o] && d3_len(d3_sub(c->object_ball[o].centre, f->org)) > c->object_ball[o].radius;
+}
+
 /* Visits (fn) or finds (fn NULL) the triangles reaching the cone. */
 static bool visit_casters(const ExactCasters *c, const Frame *f, const Ball *light, double cos_cone, ExactTriangleFn fn,
                           void *user)
@@ -128,13 +133,14 @@ static bool visit_casters(const ExactCasters *c, const Frame *f, const Ball *lig
     bool any = false;
     for (int o = 0; o < c->num_objects; o++) {
         if (!ball_in_cone(&c->object_ball[o], f, cos_cone)) continue;
+        bool front_only = outside_closed(c, o, f);
         for (int k = c->object_first[o]; k < c->object_first[o + 1]; k++) {
             if (!ball_in_cone(&c->chunk_ball[k], f, cos_cone)) continue;
             for (int t = c->chunk_first[k]; t < c->chunk_first[k + 1]; t++) {
                 if (plane_separates(&c->tri[3 * t], f, light)) continue;
                 if (!fn) return true;
                 any = true;
-                fn(user, &c->tri[3 * t]);
+                fn(user, &c->tri[3 * t], front_only);
             }
         }
     }
@@ -153,7 +159,7 @@ bool exact_object_reaches(const ExactCasters *c, int o, const LightPoints *lp)
 
 bool exact_front_faces_suffice(const ExactCasters *c, int o, const LightPoints *lp)
 {
-    return c->object_closed[o] && d3_len(d3_sub(c->object_ball[o].centre, lp->f.org)) > c->object_ball[o].radius;
+    return outside_closed(c, o, &lp->f);
 }
 
 bool exact_chunk_reaches(const ExactCasters *c, int k, const LightPoints *lp)

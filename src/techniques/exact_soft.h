@@ -109,8 +109,9 @@ float exact_sliver_visibility(const ExactCasters *c, const TechContext *ctx, int
 
 /* Calls fn for every caster triangle that can block a segment from org to a
  * kept sample (the chunks' spheres against the samples' cone, the plane of
- * each triangle against org and the light). */
-typedef void (*ExactTriangleFn)(void *user, const vec3 *tri);
+ * each triangle against org and the light), with front_only set where its
+ * object's back faces may be skipped (exact_front_faces_suffice). */
+typedef void (*ExactTriangleFn)(void *user, const vec3 *tri, bool front_only);
 void exact_for_casters(const ExactCasters *c, const LightPoints *lp, ExactTriangleFn fn, void *user);
 /* The same tests one at a time: can caster object o or chunk k reach the
  * samples' cone, can triangle t block a segment toward the light at all? */
