@@ -32,6 +32,8 @@ extern const Technique tech_occlusion_textures;
 extern const Technique tech_shadow_volume;
 extern const Technique tech_soft_shadow_volume;
 extern const Technique tech_penumbra_wedge;
+extern const Technique tech_depth_complexity;
+extern const Technique tech_view_sample_mapping;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -60,6 +62,8 @@ static const Technique *const registry[] = {
     &tech_shadow_volume,
     &tech_soft_shadow_volume,
     &tech_penumbra_wedge,
+    &tech_depth_complexity,
+    &tech_view_sample_mapping,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }

@@ -1,0 +1,133 @@
+/* exact_soft.h -- what the exact soft-shadow techniques share
+ * (`depth_complexity`, Laine et al. 2005; `view_sample_mapping`, Eisemann &
+ * Décoret 2007 / Sintorn et al. 2008; course §5.3.2.3, §5.3.3): the
+ * reference's own light samples for a view sample (rt/reference.c: same
+ * pattern, seed, count and stream, mapped by light_sample, rays from p lifted
+ * by rt_ray_offset along the geometric normal, samples on or below the
+ * geometric tangent plane left out), their projection into the normalised
+ * light frame of that sample, and the caster triangles grouped under
+ * bounding spheres, culled against the cone from the sample to the light.
+ *
+ * The normalised light frame: each direction d from the ray origin `org`
+ * maps to the gnomonic plane of the axis c toward the light's centre,
+ * x(d) = (d.u / d.c, d.v / d.c) with (u, v, c) right-handed and orthonormal;
+ * segments and triangles stay straight there. Geometry is clipped to
+ * d.c >= EXACT_CLIP_EPS first: the part behind org's plane perpendicular to
+ * c blocks no segment toward a light sample (every kept sample has d.c > 0;
+ * one that has not is left out and counted, `off_axis`). */
+#ifndef SL_EXACT_SOFT_H
+#define SL_EXACT_SOFT_H
+#include "core/mat4.h"
+#include "core/sampling.h"
+#include "rt/rt.h"
+#include "scene/light.h"
+#include "techniques/technique.h"
+
+#define EXACT_MAX_SAMPLES 1024
+#define EXACT_CLIP_EPS 1e-9      /* world units along c: the clip plane just in front of org */
+#define EXACT_AMBIGUOUS_TAN 1e-5 /* normalised-frame distance (~radians near the axis) counted as on an edge */
+#define EXACT_CHUNK 32           /* triangles per bounding sphere */
+
+/* The parameters both techniques start with (the reference's sampling). */
+enum { EXACT_P_SAMPLES, EXACT_P_PATTERN, EXACT_P_SEED, EXACT_NUM_SAMPLE_PARAMS };
+extern const char *const exact_pattern_names[];
+#define EXACT_SAMPLE_PARAMS(min_samples, def_samples, samples_doc)                                                  \
+    {"samples", PARAM_INT, def_samples, min_samples, EXACT_MAX_SAMPLES, "light samples", samples_doc, NULL},         \
+        {"pattern", PARAM_ENUM, SAMPLING_R2, 0, 2, "",                                                              \
+         "the light samples' 2D pattern, the reference's own (--pattern): r2, stratified (N a square) or random",  \
+         exact_pattern_names},                                                                                      \
+        {"seed", PARAM_INT, 1, 0, 2147483647, "",                                                                   \
+         "the light samples' seed, the reference's own (--seed): with the same N, pattern and seed the samples "   \
+         "are the reference's rays",                                                                                \
+         NULL}
+
+typedef struct Ball {
+    dvec3 centre; /* world space */
+    double radius;
+} Ball;
+
+/* Caster triangles in chunks of at most EXACT_CHUNK, each within one object. */
+typedef struct ExactCasters {
+    RTCScene rtc;      /* the casters' BVH: the techniques' one ray */
+    float extent;      /* scene_extent, for rt_ray_offset */
+    int num_tris, num_chunks, num_objects;
+    vec3 *tri;         /* world space, 3 corners each */
+    int *chunk_first;  /* per chunk: its first triangle; num_chunks + 1 */
+    Ball *chunk_ball;
+    int *object_first; /* per caster object: its first chunk; num_objects + 1 */
+    Ball *object_ball;
+    bool *object_closed; /* a closed 2-manifold (resources/silhouette.h's adjacency) */
+} ExactCasters;
+
+/* Checks the sample parameters, acquires the casters' BVH and their
+ * silhouette resource (for each object's closedness) and gathers them. */
+bool exact_casters_init(const TechContext *ctx, ExactCasters *c, Error *err);
+void exact_casters_free(ExactCasters *c);
+
+/* The normalised light frame at org. */
+typedef struct Frame {
+    dvec3 org, u, v, c;
+} Frame;
+
+typedef struct P2 {
+    double x, y;
+} P2;
+
+static inline P2 exact_project(const Frame *f, dvec3 d)
+{
+    double dc = d3_dot(d, f->c);
+    return (P2){d3_dot(d, f->u) / dc, d3_dot(d, f->v) / dc};
+}
+
+/* Twice the signed area of (a, b, p): > 0 with p left of a -> b. */
+static inline double exact_orient(P2 a, P2 b, P2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }
+
+/* One view sample's light samples. */
+typedef struct LightPoints {
+    vec3 org;                          /* ray origin, world */
+    Frame f;
+    Ball light;                        /* the light's bounding sphere */
+    int n, kept, off_axis;             /* drawn; above the tangent plane; of those left out with d.c <= 0 */
+    P2 x[EXACT_MAX_SAMPLES];           /* kept samples' projections */
+    LightSample ls[EXACT_MAX_SAMPLES];
+    bool above[EXACT_MAX_SAMPLES];     /* kept */
+    P2 lo, hi;                         /* bounds of the kept projections */
+    double cos_cone;                   /* the kept directions' least cosine to c */
+} LightPoints;
+
+/* The frame and the light's bounding sphere for view sample s; false when
+ * no caster can reach the light's cone from it (every ray is unblocked). */
+bool exact_begin(const ExactCasters *c, const TechContext *ctx, int s, LightPoints *lp);
+/* The reference's samples for view sample s (after exact_begin). */
+void exact_draw(LightPoints *lp, const TechContext *ctx, int s);
+
+/* The reference's one ray, occluded or not (rt/reference.c aim_lane). */
+bool exact_occluded(const ExactCasters *c, vec3 org, const LightSample *ls);
+/* A sliver above the horizon no sample reaches: the reference's ray toward
+ * the light's highest point. */
+float exact_sliver_visibility(const ExactCasters *c, const TechContext *ctx, int s, const LightPoints *lp);
+
+/* Calls fn for every caster triangle that can block a segment from org to a
+ * kept sample (the chunks' spheres against the samples' cone, the plane of
+ * each triangle against org and the light), with front_only set where its
+ * object's back faces may be skipped (exact_front_faces_suffice). */
+typedef void (*ExactTriangleFn)(void *user, const vec3 *tri, bool front_only);
+void exact_for_casters(const ExactCasters *c, const LightPoints *lp, ExactTriangleFn fn, void *user);
+/* The same tests one at a time: can caster object o or chunk k reach the
+ * samples' cone, can triangle t block a segment toward the light at all? */
+bool exact_object_reaches(const ExactCasters *c, int o, const LightPoints *lp);
+bool exact_chunk_reaches(const ExactCasters *c, int k, const LightPoints *lp);
+bool exact_triangle_reaches(const ExactCasters *c, int t, const LightPoints *lp);
+/* May object o's back faces (from org) be skipped? On a closed object with
+ * org outside its bounding sphere, a segment that crosses a back face
+ * crossed a front face first. */
+bool exact_front_faces_suffice(const ExactCasters *c, int o, const LightPoints *lp);
+
+/* Triangle t (world) relative to org, clipped to d.c >= EXACT_CLIP_EPS
+ * (Sutherland-Hodgman; each crossing point computed from the edge's inside
+ * corner, so both triangles of an edge clip it alike): up to 4 corners, 0
+ * when nothing is left. *facing: +1 front-facing from org, -1 back-facing,
+ * 0 edge-on. */
+int exact_clip(const Frame *f, const vec3 *t, dvec3 poly[4], int *facing);
+
+#endif

@@ -1,0 +1,243 @@
+/* view_sample_mapping.c -- `view_sample_mapping`: soft shadows by mapping
+ * each caster triangle onto the view samples it can shadow (Eisemann &
+ * Décoret 2007, "Visibility sampling on GPU and applications"; Sintorn et
+ * al. 2008, "Sample based visibility for soft shadows using alias-free
+ * shadow maps"; course §5.3.3). Per triangle: its influence region on the
+ * view samples, the triangle backprojected from each of them into the
+ * normalised light frame (exact_soft.h), one mask of light samples per edge
+ * (those on its inner side), the AND of the edges' masks (the samples the
+ * triangle hides), ORed into the view sample's bitmask of N light samples;
+ * the visibility is the fraction of kept samples left unset.
+ *
+ * Light samples are the reference's own (same pattern, seed, count and
+ * stream), so the bitmask is the reference's rays' answers, bit for bit, up
+ * to float at edges: the masks are computed exactly per sample (double
+ * orientation tests on the projected sample points) rather than read from a
+ * Hough-parametrised table (Eisemann & Décoret's quantised lookup), so there
+ * is no quantisation error; `near_edge` (aux) counts the light samples within
+ * EXACT_AMBIGUOUS_TAN of a projected edge, where the ray test and the mask
+ * may disagree.
+ *
+ * Influence region: the view samples are taken in tiles of TILE; a chunk of
+ * triangles maps onto the samples of the tile whose cone toward the light
+ * its bounding sphere reaches, and each of its triangles onto those of them
+ * the triangle's plane does not separate from the light (the exact region
+ * is inside; it is not bounded in screen space). Triangles crossing the
+ * plane through the sample perpendicular to the light's axis are clipped to
+ * its front first (exact_clip): the part behind cannot hide a light sample.
+ * Casters are assumed between receivers and light (a triangle beyond a light
+ * sample is counted as hiding it). Textured lights' sample colours are not
+ * handled: sphere, rect and disk lights. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include "techniques/exact_soft.h"
+
+#define TILE 16 /* view samples mapped together */
+/* Lit candidates x light samples mapped in one prepare, at most 2^33
+ * (sphere-on-plane at 640x480, 256 samples: 10 us per view sample on one
+ * core; 4096^2 at 256 samples is accepted, at 1024 refused). */
+#define MAX_SAMPLE_TESTS 8589934592.0
+#define WORDS (EXACT_MAX_SAMPLES / 64)
+
+static const ParamDesc vsm_params[] = {
+    EXACT_SAMPLE_PARAMS(32, 256,
+                        "N: bits of each view sample's light-sample mask (the course's 32 to 1024); the "
+                        "reference's --samples gives the same points"),
+};
+
+static const char *const vsm_resources[] = {"embree_bvh", "silhouette", NULL};
+static const char *const vsm_aux[] = {"near_edge", NULL};
+
+/* One view sample of a tile: its light samples and masks. */
+typedef struct Mapped {
+    int s;           /* view sample */
+    bool reached;    /* some caster reaches the light's cone from it */
+    int open;        /* kept light samples no triangle hides yet: 0 ends the mapping onto it (umbra) */
+    LightPoints lp;
+    uint64_t blocked[WORDS], near[WORDS];
+} Mapped;
+
+typedef struct VsmState {
+    float *vis;  /* per view sample */
+    float *near; /* per view sample: light samples within EXACT_AMBIGUOUS_TAN of a projected edge */
+} VsmState;
+
+/* The light samples inside the clipped, projected polygon q[0..np): the AND
+ * of its edges' masks (each the samples strictly on the inner side), ORed
+ * into the view sample's bitmask; samples on an edge within the tolerance
+ * are marked near. */
+static void hide_samples(Mapped *m, const P2 *q, int np, double orientation)
+{
+    const LightPoints *lp = &m->lp;
+    uint64_t inside[WORDS];
+    int words = (lp->n + 63) / 64;
+    memset(inside, 0xff, sizeof inside);
+    for (int e = 0; e < np; e++) {
+        P2 a = q[e], b = q[(e + 1) % np];
+        double len = hypot(b.x - a.x, b.y - a.y);
+        uint64_t mask[WORDS] = {0};
+        for (int i = 0; i < lp->n; i++) {
+            if (!lp->above[i] || (m->blocked[i / 64] >> (i % 64) & 1)) continue; /* left out, or hidden already */
+            double o = exact_orient(a, b, lp->x[i]) * orientation; /* > 0: the inner side */
+            if (o > 0.0) mask[i / 64] |= 1ull << (i % 64);
+            if (fabs(o) <= EXACT_AMBIGUOUS_TAN * len) {
+                double t = ((lp->x[i].x - a.x) * (b.x - a.x) + (lp->x[i].y - a.y) * (b.y - a.y)) / (len * len);
+                if (t >= 0.0 && t <= 1.0) m->near[i / 64] |= 1ull << (i % 64);
+            }
+        }
+        for (int w = 0; w < words; w++) inside[w] &= mask[w];
+    }
+    for (int w = 0; w < words; w++) {
+        m->open -= __builtin_popcountll(inside[w] & ~m->blocked[w]);
+        m->blocked[w] |= inside[w];
+    }
+}
+
+/* Triangle t backprojected from view sample m into its light frame. */
+static void map_triangle(Mapped *m, const vec3 *tri, bool front_only)
+{
+    dvec3 poly[4];
+    int facing, np = exact_clip(&m->lp.f, tri, poly, &facing);
+    if (np < 3 || facing == 0) return; /* nothing in front, or edge-on: it hides no sample */
+    if (front_only && facing < 0) return; /* a front face of the closed object hides the same samples */
+    P2 q[4];
+    double area = 0.0;
+    P2 lo = {INFINITY, INFINITY}, hi = {-INFINITY, -INFINITY};
+    for (int k = 0; k < np; k++) {
+        q[k] = exact_project(&m->lp.f, poly[k]);
+        lo = (P2){fmin(lo.x, q[k].x), fmin(lo.y, q[k].y)};
+        hi = (P2){fmax(hi.x, q[k].x), fmax(hi.y, q[k].y)};
+    }
+    const LightPoints *lp = &m->lp;
+    if (hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y) return; /* misses every sample */
+    for (int k = 1; k + 1 < np; k++) area += exact_orient(q[0], q[k], q[k + 1]);
+    if (area == 0.0) return;
+    hide_samples(m, q, np, area > 0.0 ? 1.0 : -1.0);
+}
+
+/* Kept light samples whose bit in mask is `set`. */
+static int count_kept(const uint64_t *mask, bool set, const LightPoints *lp)
+{
+    int c = 0;
+    for (int i = 0; i < lp->n; i++) c += lp->above[i] && (((mask[i / 64] >> (i % 64)) & 1) != 0) == set;
+    return c;
+}
+
+/* Maps every caster chunk onto the tile's `count` view samples. */
+static void map_tile(const ExactCasters *cs, const TechContext *ctx, Mapped *tile, int count, VsmState *st)
+{
+    for (int k = 0; k < count; k++) {
+        Mapped *m = &tile[k];
+        memset(m->blocked, 0, sizeof m->blocked);
+        memset(m->near, 0, sizeof m->near);
+        m->reached = exact_begin(cs, ctx, m->s, &m->lp);
+        if (m->reached) exact_draw(&m->lp, ctx, m->s);
+        m->open = m->reached ? m->lp.kept : 0;
+    }
+    bool in[TILE], front_only[TILE];
+    for (int o = 0; o < cs->num_objects; o++) {
+        for (int k = 0; k < count; k++) {
+            in[k] = tile[k].open > 0 && exact_object_reaches(cs, o, &tile[k].lp);
+            front_only[k] = in[k] && exact_front_faces_suffice(cs, o, &tile[k].lp);
+        }
+        for (int c = cs->object_first[o]; c < cs->object_first[o + 1]; c++)
+            for (int k = 0; k < count; k++) {
+                Mapped *m = &tile[k];
+                if (!in[k] || m->open == 0 || !exact_chunk_reaches(cs, c, &m->lp)) continue;
+                for (int t = cs->chunk_first[c]; t < cs->chunk_first[c + 1] && m->open > 0; t++)
+                    if (exact_triangle_reaches(cs, t, &m->lp)) map_triangle(m, &cs->tri[3 * t], front_only[k]);
+            }
+    }
+    for (int k = 0; k < count; k++) {
+        Mapped *m = &tile[k];
+        const LightPoints *lp = &m->lp;
+        if (!m->reached) { st->vis[m->s] = 1.0f; st->near[m->s] = 0.0f; continue; }
+        if (lp->kept == 0) { st->vis[m->s] = exact_sliver_visibility(cs, ctx, m->s, lp); st->near[m->s] = 0.0f; continue; }
+        st->vis[m->s] = (float)count_kept(m->blocked, false, lp) / (float)lp->kept;
+        st->near[m->s] = (float)(count_kept(m->near, true, lp) + lp->off_axis);
+    }
+}
+
+static bool map_all(const ExactCasters *cs, const TechContext *ctx, VsmState *st, Error *err)
+{
+    int n = ctx->vs->count, failed = 0;
+#pragma omp parallel reduction(+ : failed)
+    {
+        Mapped *tile = malloc(sizeof *tile * TILE);
+        failed += !tile;
+#pragma omp for schedule(dynamic, 1)
+        for (int first = 0; first < n; first += TILE) {
+            int count = 0;
+            for (int s = first; tile && s < first + TILE && s < n; s++)
+                if (ctx->cls[s] == SAMPLE_LIT_CANDIDATE) tile[count++].s = s;
+            if (tile) map_tile(cs, ctx, tile, count, st);
+        }
+        free(tile);
+    }
+    return failed ? error_set(err, "out of memory for view_sample_mapping's tiles") : true;
+}
+
+static void vsm_release(void *state)
+{
+    VsmState *st = state;
+    if (!st) return;
+    free(st->vis);
+    free(st->near);
+    free(st);
+}
+
+static bool vsm_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    long lit = 0;
+    for (int s = 0; s < ctx->vs->count; s++) lit += ctx->cls[s] == SAMPLE_LIT_CANDIDATE;
+    double tests = (double)lit * ctx->params[EXACT_P_SAMPLES];
+    if (tests > MAX_SAMPLE_TESTS)
+        return error_set(err, "%ld lit view samples x samples=%d light samples = %.3g exceed the "
+                              "bound of %.3g mask bits per frame; lower -p samples or the image size",
+                         lit, (int)ctx->params[EXACT_P_SAMPLES], tests, MAX_SAMPLE_TESTS);
+    ExactCasters cs;
+    if (!exact_casters_init(ctx, &cs, err)) return false;
+    VsmState *st = calloc(1, sizeof *st);
+    bool ok = st && (st->vis = malloc(sizeof *st->vis * (size_t)ctx->vs->count)) &&
+              (st->near = malloc(sizeof *st->near * (size_t)ctx->vs->count));
+    if (!ok) error_set(err, "out of memory for %d view samples' masks", ctx->vs->count);
+    ok = ok && map_all(&cs, ctx, st, err);
+    exact_casters_free(&cs);
+    if (!ok) {
+        vsm_release(st);
+        return false;
+    }
+    *state = st;
+    return true;
+}
+
+static void vsm_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
+{
+    const VsmState *st = state;
+    for (int s = begin; s < end; s++) {
+        if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        tech_store(ctx, out, begin, s, st->vis[s]);
+        if (ctx->aux) ctx->aux[s] = st->near[s];
+    }
+}
+
+const Technique tech_view_sample_mapping = {
+    .name = "view_sample_mapping",
+    .family = "geometry",
+    .source = "course §5.3.3 (Eisemann & Décoret 2007; Sintorn et al. 2008)",
+    .summary = "each caster triangle mapped onto the view samples it can shadow, backprojected into their light "
+               "frames, its edges' sample masks ANDed and ORed into a per-sample bitmask of the reference's light "
+               "samples",
+    .params = vsm_params,
+    .num_params = (int)(sizeof vsm_params / sizeof vsm_params[0]),
+    .resources = vsm_resources,
+    .rgb = false,
+    .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK),
+    .main_param = "samples",
+    .prepare = vsm_prepare,
+    .evaluate = vsm_evaluate,
+    .release = vsm_release,
+    .aux = vsm_aux,
+};
