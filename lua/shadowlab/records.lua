@@ -69,6 +69,7 @@ records.standard_columns = {
   { "key", function(r) return r.key end },
   { "status", function(r) return r.status end },
   { "scene", function(r) return r.variant and r.variant.scene end },
+  { "scene_hash", record_field("scene", "hash") },
   { "variant", function(r) return r.variant and r.variant.label end },
   { "technique", function(r) return r.technique end },
   { "label", function(r) return r.label end },

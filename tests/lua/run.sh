@@ -93,7 +93,7 @@ expect sweep_runs_and_reports 0 "6 computed" "report:" -- "$SL" run "$SWEEP" --o
 [ "$(rows "$FULL/records.jsonl")" -eq 6 ] && ok sweep_records_six_rows || no sweep_records_six_rows "$(rows "$FULL/records.jsonl") rows"
 [ "$(wc -l <"$FULL/results.csv")" -eq 7 ] && ok sweep_csv_has_a_line_per_row || no sweep_csv_has_a_line_per_row "csv"
 missing=""
-for c in reference_pattern reference_seed reference_measure reference_rays supersample cpu commit threads; do
+for c in scene_hash reference_pattern reference_seed reference_measure reference_rays supersample cpu commit threads; do
     head -1 "$FULL/results.csv" | tr ',' '\n' | grep -qx "$c" || missing="$missing $c"
 done
 [ -z "$missing" ] && ok sweep_csv_says_how_it_was_measured || no sweep_csv_says_how_it_was_measured "lacks$missing"
