@@ -66,6 +66,8 @@ function experiment.new(spec)
   local self = setmetatable({ name = spec.name, description = spec.description, variants = {}, entries = {} },
                             Experiment)
   for k, v in pairs(defaults) do self[k] = spec[k] == nil and v or spec[k] end
+  local metric_ok, why = records.metric_path(self.error)
+  if not metric_ok then error("experiment.new: error: " .. why, 2) end -- before any row runs
   if type(self.error_scale) ~= "number" or not (self.error_scale >= 0 and self.error_scale <= 1e6) then
     error("experiment.new: error_scale must be a number in [0, 1e6] (0: each error image its own scale), got " ..
           tostring(self.error_scale), 2)
@@ -408,7 +410,7 @@ end
 -- The value of a metric path "region.field" (exp.error, the one its report
 -- plots) in a record's metrics: "-" for an empty region (null).
 local function metric_text(metrics, path)
-  local region, field = path:match("^(%w+)%.([%w_]+)$")
+  local region, field = records.metric_path(path)
   local v = region and metrics[region] and metrics[region][field]
   return type(v) == "number" and string.format("%.5f", v) or "-"
 end

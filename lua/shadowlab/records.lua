@@ -173,6 +173,26 @@ function records.builds(rows)
   return list
 end
 
+-- The error metrics a report plots and progress lines print: "REGION.FIELD"
+-- (or FIELD, the whole image's) of the record's per-region statistics
+-- (src/lab/record.c). Returns region, field; or nil and a message listing
+-- the valid names.
+records.metric_regions = { "all", "umbra", "penumbra", "lit", "terminator" }
+records.metric_fields = { "rmse", "rmse_debiased", "mae", "max_abs", "mean_signed", "leak_mean", "dark_mean",
+                          "misclassified", "noise_rms", "noise_mean" }
+local function member(list, v)
+  for _, x in ipairs(list) do if x == v then return true end end
+  return false
+end
+function records.metric_path(path)
+  local region, field = tostring(path):match("^(%w+)%.([%w_]+)$")
+  if not region then region, field = "all", tostring(path) end
+  if member(records.metric_regions, region) and member(records.metric_fields, field) then return region, field end
+  return nil, string.format("unknown error metric '%s'; valid: REGION.FIELD with REGION one of %s and FIELD one " ..
+                            "of %s (e.g. penumbra.rmse; a bare FIELD means all.FIELD)", tostring(path),
+                            table.concat(records.metric_regions, ", "), table.concat(records.metric_fields, ", "))
+end
+
 local standard_getter = {}
 for _, c in ipairs(records.standard_columns) do standard_getter[c[1]] = c[2] end
 

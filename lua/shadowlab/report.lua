@@ -6,6 +6,7 @@
 -- swept parameter. Every plot names its scene, resolution, reference samples
 -- and reference noise (plot.lua builds that from the rows it is given).
 local json = require "shadowlab.json"
+local records = require "shadowlab.records"
 local pareto = require "shadowlab.pareto"
 local plot = require "shadowlab.plot"
 local html = require "shadowlab.html"
@@ -46,9 +47,6 @@ end
 -- The names report.write accepts: error = "REGION.FIELD" (or FIELD, the
 -- whole image's), time = one of time_order; the metrics are the record's
 -- per-region statistics (src/lab/record.c).
-local region_order = { "all", "umbra", "penumbra", "lit", "terminator" }
-local field_order = { "rmse", "rmse_debiased", "mae", "max_abs", "mean_signed", "leak_mean", "dark_mean",
-                      "misclassified", "noise_rms", "noise_mean" }
 local time_order = { "frame", "evaluate_median", "evaluate_min" }
 
 local function member(list, v)
@@ -60,14 +58,8 @@ end
 -- the getter returns nil for an empty region (json.null), so it is not
 -- plotted. An unknown region or field is refused with the valid names.
 local function metric_getter(path)
-  local region, field = tostring(path):match("^(%w+)%.([%w_]+)$")
-  if not region then region, field = "all", path end
-  if not (member(region_order, region) and member(field_order, field)) then
-    error(string.format("report.write: unknown error metric '%s'; valid: REGION.FIELD with REGION one of %s and " ..
-                        "FIELD one of %s (e.g. penumbra.rmse; a bare FIELD means all.FIELD); the rows are " ..
-                        "recorded: rerun with --resume", tostring(path), table.concat(region_order, ", "),
-                        table.concat(field_order, ", ")), 3)
-  end
+  local region, field = records.metric_path(path)
+  if not region then error("report.write: " .. field .. "; the rows are recorded: rerun with --resume", 3) end
   local label = (field_names[field] or field) .. (region == "all" and "" or " (" .. region .. ")")
   return function(r)
     local m = r.record.metrics[region]

@@ -364,6 +364,11 @@ test("records_carry_the_scene_overrides_as_written", function()
   assert(text == "camera.height=12 camera.width=16 lights[1].radius=0.1", "overrides: " .. text)
 end)
 
+test("experiment_refuses_an_unknown_metric_before_running", function()
+  expect_error(function() experiment.new{ name = "bad-metric", error = "penumbra_rmse" } end,
+               "unknown error metric 'penumbra_rmse'", "penumbra.rmse", "terminator")
+end)
+
 test("experiment_progress_prints_the_metric_its_report_plots", function()
   local out = tmp .. "/progress"
   local exp = experiment.new{ name = "progress", samples = 4, repeats = 1, warmup = 0, error = "penumbra.rmse",
