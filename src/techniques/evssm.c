@@ -72,20 +72,15 @@ static bool evssm_prepare(const TechContext *ctx, void **state, Error *err)
     return true;
 }
 
-/* Chebyshev on the positive warp at the receiver, the clamp scaled by the
- * warp's slope there (w' = c w), as evsm's. */
+/* EVSM's bounds on the window's moments (filtered.h), as evsm's. */
 static double positive_bound(const EvssmState *st, const double *m, double u)
 {
-    double w = exp(st->c_pos * (u - 1.0)), slope = st->c_pos * w;
-    return chebyshev_upper(m[0], m[1], w, st->min_variance * slope * slope);
+    return evsm_positive_bound(m, u, st->c_pos, st->min_variance);
 }
 
-/* Chebyshev on the negative warp -e^(-c- u) at the receiver, the clamp
- * scaled by the warp's slope there, as evsm's. */
 static double negative_bound(const EvssmState *st, const double *m, double u)
 {
-    double w = exp(-st->c_neg * u), slope = st->c_neg * w;
-    return chebyshev_upper(m[2], m[3], -w, st->min_variance * slope * slope);
+    return evsm_negative_bound(m, u, st->c_neg, st->min_variance);
 }
 
 /* course §4.2.4: p = min(p+, p-). */

@@ -41,6 +41,18 @@ double chebyshev_upper(double mean, double m2, double d, double min_variance)
     return den > 0.0 ? var / den : 1.0; /* den = 0: var = 0 and (d - mean)^2 underflowed, d == mean in effect */
 }
 
+double evsm_positive_bound(const double *m, double u, double c_pos, double min_variance)
+{
+    double w = exp(c_pos * (u - 1.0)), slope = c_pos * w;
+    return chebyshev_upper(m[0], m[1], w, min_variance * slope * slope);
+}
+
+double evsm_negative_bound(const double *m, double u, double c_neg, double min_variance)
+{
+    double w = exp(-c_neg * u), slope = c_neg * w;
+    return chebyshev_upper(m[2], m[3], -w, min_variance * slope * slope);
+}
+
 double bleed_reduce(double p, double amount)
 {
     if (!(amount > 0.0)) return p;

@@ -77,6 +77,12 @@ bool filtered_lookup(const FilteredMaps *fm, const TechContext *ctx, int s, Filt
  * (the text's "sigma", erratum 1) clamped below by min_variance; NaN when
  * a moment or d is NaN (a NaN depth in the window). */
 double chebyshev_upper(double mean, double m2, double d, double min_variance);
+/* EVSM's two bounds (course §4.2.4): Chebyshev on the positive warp
+ * e^(c+ (u - 1)) from moments m[0], m[1], and on the negative warp
+ * -e^(-c- u) from m[2], m[3], at the receiver's normalised depth u, each
+ * with the variance clamp scaled by the warp's slope there (w' = c w). */
+double evsm_positive_bound(const double *m, double u, double c_pos, double min_variance);
+double evsm_negative_bound(const double *m, double u, double c_neg, double min_variance);
 /* course §4.2.2: light-bleeding reduction, p < amount -> 0 and [amount, 1]
  * smoothstep-remapped onto [0, 1]; amount 0 leaves p unchanged. */
 double bleed_reduce(double p, double amount);

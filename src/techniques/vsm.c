@@ -151,13 +151,8 @@ static double lvsm_lit(const MomentState *st, const double *m, double u)
  * the receiver (w' = c w), p = min(p+, p-) (course §4.2.4). */
 static double evsm_lit(const MomentState *st, const double *m, double u)
 {
-    double wp = exp(st->c_pos * (u - 1.0)), sp = st->c_pos * wp;
-    double p = chebyshev_upper(m[0], m[1], wp, st->min_variance * sp * sp);
-    if (st->negative) {
-        double wn = exp(-st->c_neg * u), sn = st->c_neg * wn;
-        p = nan_min(p, chebyshev_upper(m[2], m[3], -wn, st->min_variance * sn * sn));
-    }
-    return p;
+    double p = evsm_positive_bound(m, u, st->c_pos, st->min_variance);
+    return st->negative ? nan_min(p, evsm_negative_bound(m, u, st->c_neg, st->min_variance)) : p;
 }
 
 #define MSM_PIVOT_MIN 1e-12
