@@ -2,6 +2,7 @@
 #include "core/machine.h"
 #include <stdio.h>
 #include <string.h>
+#include <sys/utsname.h>
 
 void machine_cpu_model(char *out, size_t n)
 {
@@ -18,4 +19,17 @@ void machine_cpu_model(char *out, size_t n)
         }
     }
     fclose(fp);
+}
+
+void machine_info(MachineInfo *m)
+{
+    struct utsname u;
+    memset(m, 0, sizeof *m);
+    machine_cpu_model(m->cpu, sizeof m->cpu);
+    m->named = uname(&u) == 0;
+    if (!m->named) return;
+    snprintf(m->host, sizeof m->host, "%s", u.nodename);
+    snprintf(m->system, sizeof m->system, "%s", u.sysname);
+    snprintf(m->release, sizeof m->release, "%s", u.release);
+    snprintf(m->arch, sizeof m->arch, "%s", u.machine);
 }

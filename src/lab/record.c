@@ -5,7 +5,6 @@
  * alone. */
 #include <math.h>
 #include <string.h>
-#include <sys/utsname.h>
 #include "core/fsutil.h"
 #include "core/hash.h"
 #include "core/json.h"
@@ -15,17 +14,16 @@
 
 static void write_machine(JsonWriter *w, int threads)
 {
-    struct utsname u;
-    char cpu[256];
-    machine_cpu_model(cpu, sizeof cpu);
+    MachineInfo m;
+    machine_info(&m);
     json_object_begin(w, "machine");
-    if (uname(&u) == 0) {
-        json_string(w, "host", u.nodename);
-        json_string(w, "system", u.sysname);
-        json_string(w, "release", u.release);
-        json_string(w, "arch", u.machine);
+    if (m.named) {
+        json_string(w, "host", m.host);
+        json_string(w, "system", m.system);
+        json_string(w, "release", m.release);
+        json_string(w, "arch", m.arch);
     }
-    json_string(w, "cpu", cpu);
+    json_string(w, "cpu", m.cpu);
     json_int(w, "threads", threads);
     json_string(w, "commit", SHADOWLAB_COMMIT);
     json_string(w, "dirty_files", SHADOWLAB_DIRTY); /* what differs from the commit at build time */

@@ -10,7 +10,6 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/utsname.h>
 #include <unistd.h>
 #include "core/hash.h"
 #include "core/machine.h"
@@ -108,18 +107,17 @@ static int sl_default_cache(lua_State *L)
  * experiments compare it with recorded rows before mixing new rows in. */
 static int sl_machine(lua_State *L)
 {
-    char cpu[256];
-    struct utsname u;
-    machine_cpu_model(cpu, sizeof cpu);
+    MachineInfo m;
+    machine_info(&m);
     lua_createtable(L, 0, 5);
     lua_pushstring(L, SHADOWLAB_COMMIT);
     lua_setfield(L, -2, "commit");
-    lua_pushstring(L, cpu);
+    lua_pushstring(L, m.cpu);
     lua_setfield(L, -2, "cpu");
-    if (uname(&u) == 0) {
-        lua_pushstring(L, u.machine);
+    if (m.named) {
+        lua_pushstring(L, m.arch);
         lua_setfield(L, -2, "arch");
-        lua_pushstring(L, u.nodename);
+        lua_pushstring(L, m.host);
         lua_setfield(L, -2, "host");
     }
     lua_pushinteger(L, omp_get_max_threads());
