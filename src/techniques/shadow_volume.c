@@ -334,9 +334,9 @@ static bool sv_prepare(const TechContext *ctx, void **state, Error *err)
     uint64_t key = hash_final(&h);
     const SvCounts *c = rm_acquire(ctx->rm, &kind_counts, key, desc, build_counts, &a, err);
     if (!c) return false;
-    char fill[128]; /* the fill the course's cost discussion is about (§2.3: "high fill from long quads") */
-    snprintf(fill, sizeof fill, "%ld volume triangles, %ld drawn, %ld fragments counted", c->fill.triangles_in,
-             c->fill.triangles_drawn, c->fill.texels_written);
+    char fill[160]; /* the cost the course's discussion is about (§2.3: silhouette edges, "high fill from long quads") */
+    snprintf(fill, sizeof fill, "%d silhouette edges, %ld volume triangles, %ld drawn, %ld fragments counted",
+             sil->num_edges, c->fill.triangles_in, c->fill.triangles_drawn, c->fill.texels_written);
     rm_log_note(ctx->rm, kind_counts.name, key, fill);
     *state = (void *)c;
     return true;

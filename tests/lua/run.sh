@@ -283,10 +283,13 @@ run_repro course-fig4.3-pcf-umbra --set camera.width=80 --set camera.height=60 -
     --no-images --quiet --threads 1 # 32x24 and 4 samples leave no penumbra to compare
 run_repro course-fig4.7-csm-terms --map-size 128 $TINYQ
 run_repro fig3-10-12-partitions $TINYQ
+run_repro course-fig2.4-2.10-shadow-volumes --quick 1 --rounds 1 --set camera.width=64 --set camera.height=48 --threads 1
+run_repro exact-soft-vs-rays --quick 1 --set camera.width=48 --set camera.height=36 --threads 1
 wait "$lane"
 for e in seed000-fig3 seed001-adaptive-area seed002-single-sample seed003-shadow-width seed003-table1 \
          course-fig2.2-bias course-fig2.3-midpoint course-fig4.3-pcf-umbra course-fig4.5-vsm-bleeding \
-         course-fig4.7-csm-terms fig3-7-aliasing-vs-z fig3-10-12-partitions fig3-13-storage-factor; do
+         course-fig4.7-csm-terms fig3-7-aliasing-vs-z fig3-10-12-partitions fig3-13-storage-factor \
+         course-fig2.4-2.10-shadow-volumes exact-soft-vs-rays; do
     expect "${e}_reproduces" 0 "paper against measured" "reproduction:" -- \
         sh -c 'cat "$1.log"; exit "$(cat "$1.rc" 2>/dev/null || echo 1)"' sh "$R/$e"
 done
@@ -319,6 +322,17 @@ figure fig3_7_lispsm_product "$R/fig3-7-aliasing-vs-z/reproduction.csv" measured
 figure fig3_13_no_warping_behind "$R/fig3-13-storage-factor/reproduction.csv" measured 0.9 1.1 item~"behind: W" --hold
 figure fig3_10_12_lispsm_helps_high_sun "$R/fig3-10-12-partitions/reproduction.csv" measured 0 1 \
     item~"high-sun: LiSPSM" --hold
+
+# shadow volumes with the camera inside one (Fig. 2.6): z-pass wrong almost everywhere, z-fail and ZP+ at a rim
+figure course_fig2_6_zpass_fails_inside "$R/course-fig2.4-2.10-shadow-volumes/reproduction.csv" measured 0.5 1 \
+    item~"z-pass, camera inside" --hold
+figure course_fig2_7_zfail_holds_inside "$R/course-fig2.4-2.10-shadow-volumes/reproduction.csv" measured 0 0.01 \
+    item~"zfail, camera inside" --hold
+figure course_fig2_4_frame_ratios "$R/course-fig2.4-2.10-shadow-volumes/reproduction.csv" measured 1e-9 1e9 \
+    quantity~"frame time ratio"
+# depth-complexity sampling and view-sample mapping with the reference's light samples: the same image
+figure laine2005_same_image "$R/exact-soft-vs-rays/reproduction.csv" measured 0 0.001 quantity~"off by" --hold
+figure laine2005_time_ratio "$R/exact-soft-vs-rays/reproduction.csv" measured 1e-9 1e9 quantity~"reference time"
 
 # ---- the report in headless Chromium: every image and plot loads, nothing logged
 browse() { # browse DIR [HASH]: DOM after load in $TMP/dom.html, browser log in $TMP/browser.log
