@@ -177,6 +177,10 @@ plot x with lines dashtype 2 title 'ideal'"
     echo "## 7. Start-up (target: no OpenImageIO, first line under 20 ms)"
     echo
     table startup.csv command first_line_ms exit_ms loads_openimageio within load_1min
+    echo "## 8. Geometry (issue 14): silhouette extraction against triangles; shadow volumes against sm and hard"
+    echo
+    table silhouette.csv segments triangles silhouette_edges build_ms ns_per_triangle ns_per_triangle_over_smallest threads load_1min
+    table volumes.csv scene triangles versus map_size shadow_volume_ms other_ms ratio threads load_1min commit
 } > "$md"
 plots
 echo "report: $md"

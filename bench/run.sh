@@ -73,6 +73,9 @@ run "$bin/memory" --res 4096 --threads "$threads" -o "$out"
 step 7 "start-up"
 run "$bin/startup" "$bin/../shadowlab" --repeat 21 -o "$out"
 
+step 8 "geometry: silhouette extraction against triangles, shadow volumes against sm and hard"
+run "$bin/geometry" --threads "$threads" --repeat "$repeat" -o "$out" scenes/bunny.lua scenes/terrain.lua
+
 uptime >> "$out/load.txt"
 current=report
 run ./bench/report.sh "$out"
