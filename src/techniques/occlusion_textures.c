@@ -10,9 +10,22 @@
  * centre crosses the slice: p's own texel, since the map looks from that
  * centre. In the face's tangent units K's half-width is the light's
  * footprint on the slice plane, backproject_footprint (backproject.h).
- * Filtering is one summed-area table per slice (exact box means at any K;
- * the N-buffers the paper advocates and the mipmap are not built), so the
- * cost per receiver is O(S), independent of the light's size.
+ * The box filter (course §5.2.5, step 3) is one of three prefilters of each
+ * slice's occupancy, each O(1) per slice, so the cost per receiver is O(S),
+ * independent of the light's size:
+ *   nbuffer (the paper's advocated one; Décoret 2005's N-buffers): level l
+ *     holds the mean over the 2^l x 2^l texels starting at each texel
+ *     (edge-clamped), l = 0 .. log2(map_size); a K-wide window reads the
+ *     level with 2^l <= K < 2^(l+1) at ceil(K / 2^l) block starts per axis
+ *     spread from its first texel to its last block (two per axis: the
+ *     N-buffer's four overlapping lookups) and averages them [derived: the
+ *     blocks overlap, so the mean weighs the window's middle up to twice;
+ *     exact where K is a power of two];
+ *   sat: a summed-area table of the occupied-texel counts (Crow 1984):
+ *     exact box means at any K (integer counts: no SAT rounding);
+ *   mipmap: a 2x2 box pyramid, read bilinearly at the window's centre at
+ *     the level nearest log2(K) [derived: the course's "mipmap
+ *     (artifacts)": power-of-two boxes, blocky where the level switches].
  *
  * Known failures, as the course lists them: the fusion is multiplicative
  * (overlapping occluders in different slices darken too little, in one
@@ -21,16 +34,18 @@
  * the map's first layer (an occluder hidden from the light's centre is in
  * no slice; the paper renders each slice's geometry).
  *
- * A NaN depth (issue 13 §1) is a caster of unknown slice, or none: one more
- * table per face counts such texels, and a receiver whose window in a slice
+ * A NaN depth (issue 13 §1) is a caster of unknown slice, or none: a SAT
+ * per face counts such texels (whatever the filter), and a receiver whose window in a slice
  * in front holds one is NaN (the counts are integers: no NaN spreads to the
  * windows after it, as it would through a float SAT). The slices' depth
  * range is the finite depths'. */
 #include <stdlib.h>
 #include "techniques/backproject.h"
 
-enum { P_SLICES = SMAP_NUM_PARAMS };
+enum { P_SLICES = SMAP_NUM_PARAMS, P_FILTER };
 #define OT_MAX_SLICES 16
+enum { FILTER_NBUFFER, FILTER_SAT, FILTER_MIPMAP };
+static const char *const filter_names[] = {"nbuffer", "sat", "mipmap", NULL};
 
 /* Plain perspective faces only (softmap.h): no warps or frustum-face splits. */
 static const ParamDesc ot_params[] = {
@@ -41,8 +56,14 @@ static const ParamDesc ot_params[] = {
      * 0.241; 4 slices leak 0.48 under overlap.lua's two slabs (they share a slice). */
     {"slices", PARAM_INT, 6, 1, OT_MAX_SLICES, "slices",
      "S: slices of each face's caster depth range, uniform in depth (course §5.2.5: \"between 4 and 16\"); "
-     "memory (S + 1) x (map_size + 1)^2 x 4 bytes per face (one more table counts NaN texels)",
+     "memory per face: S x (log2(map_size) + 1) x map_size^2 x 4 bytes (nbuffer), S x (map_size + 1)^2 x 4 "
+     "(sat) or S x 4/3 x map_size^2 x 4 (mipmap), plus (map_size + 1)^2 x 4 counting NaN texels",
      NULL},
+    {"filter", PARAM_ENUM, FILTER_NBUFFER, 0, 2, "",
+     "box filter of each slice's occupancy (course §5.2.5 step 3): nbuffer (the paper's; Décoret 2005: four "
+     "overlapping power-of-two blocks, exact at power-of-two windows), sat (summed-area table: exact at any "
+     "window) or mipmap (bilinear at the nearest power-of-two level: blocky)",
+     filter_names},
 };
 
 static const char *const ot_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", NULL};
@@ -51,18 +72,50 @@ typedef struct OtFace {
     double z0, thick; /* slice k holds depths [z0 + k thick, z0 + (k + 1) thick), the last also z0 + S thick */
 } OtFace;
 
+#define OT_MAX_LEVELS 16 /* levels of a map_size <= 16384 pyramid or N-buffer: log2(16384) + 1 = 15 */
+
 typedef struct OtState {
     SoftMap sm;
     SmapBias bias;
-    int slices, stride;  /* stride = map_size + 1: a SAT row */
+    int slices, filter;
+    int stride;          /* map_size + 1: a SAT row */
+    int tables;          /* SATs per face: table 0 counts the NaN texels, tables 1 .. S slice k - 1's (filter sat) */
     OtFace face[LIGHTVIEW_MAX_FACES];
-    uint32_t *sat;       /* [(face * (slices + 1) + k) * stride^2 + j * stride + i]: occupied texels of slice k
-                          * below (i, j); table k = slices counts the NaN texels */
+    uint32_t *sat;       /* [(face * tables + t) * stride^2 + j * stride + i]: texels of table t below (i, j) */
+    /* nbuffer and mipmap: `levels` levels of each slice's occupancy mean,
+     * level l at level_at[l] floats into the slice's block of slice_floats,
+     * level_res[l] texels a side (nbuffer: map_size; mipmap: ceil(map_size / 2^l)). */
+    int levels, level_res[OT_MAX_LEVELS];
+    size_t level_at[OT_MAX_LEVELS], slice_floats;
+    float *level;        /* [(face * slices + k) * slice_floats + level_at[l] + j * level_res[l] + i] */
 } OtState;
 
-static uint32_t *sat_of(const OtState *st, int face, int k)
+static uint32_t *sat_of(const OtState *st, int face, int table)
 {
-    return st->sat + ((size_t)face * (st->slices + 1) + k) * (size_t)st->stride * st->stride;
+    return st->sat + ((size_t)face * st->tables + table) * (size_t)st->stride * st->stride;
+}
+
+static float *level_of(const OtState *st, int face, int k, int l)
+{
+    return st->level + ((size_t)face * st->slices + k) * st->slice_floats + st->level_at[l];
+}
+
+/* The level layout of the filter: an N-buffer has a full-resolution level
+ * per power of two up to map_size, a mipmap halves (rounding up) down to 1. */
+static void level_layout(OtState *st, int res)
+{
+    st->levels = 0;
+    st->slice_floats = 0;
+    if (st->filter == FILTER_SAT) return;
+    for (int l = 0, n = res; l < OT_MAX_LEVELS; l++) {
+        bool nbuffer = st->filter == FILTER_NBUFFER;
+        if (nbuffer ? (1 << l) > res : (l > 0 && st->level_res[l - 1] == 1)) break;
+        st->level_res[l] = nbuffer ? res : n;
+        st->level_at[l] = st->slice_floats;
+        st->slice_floats += (size_t)st->level_res[l] * st->level_res[l];
+        st->levels = l + 1;
+        n = (n + 1) / 2;
+    }
 }
 
 /* The depth range of a face's casters (world units), [+INF, -INF] when empty. */
@@ -88,8 +141,50 @@ static int slice_of(const OtFace *f, int slices, double d)
     return k >= 0.0 ? (int)fmin(k, slices - 1) : 0;
 }
 
-/* Slice k's SAT from each texel's slice (OT_EMPTY: no caster; slices: NaN), one pass per table. */
-#define OT_EMPTY 255
+#define OT_EMPTY 255 /* a texel's slice index: no caster; `slices`: NaN */
+
+/* The SAT of the texels whose slice index is `value`. */
+static void build_sat(uint32_t *sat, const uint8_t *slice, int res, int value)
+{
+    int n = res + 1;
+    for (int j = 0; j < res; j++) {
+        uint32_t row = 0;
+        for (int i = 0; i < res; i++) {
+            row += slice[(size_t)j * res + i] == value;
+            sat[(size_t)(j + 1) * n + i + 1] = sat[(size_t)j * n + i + 1] + row;
+        }
+    }
+}
+
+static int clamp_index(int i, int n) { return i < n ? i : n - 1; }
+
+/* Slice k's levels from its occupancy: N-buffer level l the mean of the four
+ * level l - 1 blocks at offsets 0 and 2^(l-1) (edge-clamped, Décoret 2005);
+ * mipmap level l the mean of the 2x2 children (edge-clamped). */
+static void build_levels(const OtState *st, int face, int k, const uint8_t *slice)
+{
+    int res = st->level_res[0];
+    float *l0 = level_of(st, face, k, 0);
+    for (size_t t = 0; t < (size_t)res * res; t++) l0[t] = slice[t] == k ? 1.0f : 0.0f;
+    for (int l = 1; l < st->levels; l++) {
+        const float *a = level_of(st, face, k, l - 1);
+        float *b = level_of(st, face, k, l);
+        int na = st->level_res[l - 1], nb = st->level_res[l];
+        bool nbuffer = st->filter == FILTER_NBUFFER;
+        int h = nbuffer ? 1 << (l - 1) : 1;
+        for (int j = 0; j < nb; j++)
+            for (int i = 0; i < nb; i++) {
+                int i0 = nbuffer ? i : 2 * i, j0 = nbuffer ? j : 2 * j;
+                int i1 = clamp_index(i0 + h, na), j1 = clamp_index(j0 + h, na);
+                i0 = clamp_index(i0, na);
+                j0 = clamp_index(j0, na);
+                b[(size_t)j * nb + i] = 0.25f * (a[(size_t)j0 * na + i0] + a[(size_t)j0 * na + i1] +
+                                                 a[(size_t)j1 * na + i0] + a[(size_t)j1 * na + i1]);
+            }
+    }
+}
+
+/* Each texel's slice, then the NaN counts' SAT and the filter's tables. */
 static bool build_face(OtState *st, int face)
 {
     OtFace *f = &st->face[face];
@@ -97,7 +192,7 @@ static bool build_face(OtState *st, int face)
     face_range(&st->sm, face, &lo, &hi);
     f->z0 = isfinite(lo) ? lo : 0.0;
     f->thick = isfinite(lo) ? (hi - lo) / st->slices : 0.0;
-    int res = st->sm.map->res, n = st->stride;
+    int res = st->sm.map->res;
     uint8_t *slice = malloc((size_t)res * res);
     if (!slice) return false;
     for (int j = 0; j < res; j++)
@@ -106,16 +201,9 @@ static bool build_face(OtState *st, int face)
             slice[(size_t)j * res + i] =
                 isnan(d) ? (uint8_t)st->slices : isfinite(d) ? (uint8_t)slice_of(f, st->slices, d) : OT_EMPTY;
         }
-    for (int k = 0; k <= st->slices; k++) {
-        uint32_t *sat = sat_of(st, face, k);
-        for (int j = 0; j < res; j++) {
-            uint32_t row = 0;
-            for (int i = 0; i < res; i++) {
-                row += slice[(size_t)j * res + i] == k;
-                sat[(size_t)(j + 1) * n + i + 1] = sat[(size_t)j * n + i + 1] + row;
-            }
-        }
-    }
+    build_sat(sat_of(st, face, 0), slice, res, st->slices);
+    for (int t = 1; t < st->tables; t++) build_sat(sat_of(st, face, t), slice, res, t - 1);
+    for (int k = 0; k < st->slices && st->levels > 0; k++) build_levels(st, face, k, slice);
     free(slice);
     return true;
 }
@@ -123,7 +211,10 @@ static bool build_face(OtState *st, int face)
 static void ot_release(void *state)
 {
     OtState *st = state;
-    if (st) free(st->sat);
+    if (st) {
+        free(st->sat);
+        free(st->level);
+    }
     free(st);
 }
 
@@ -140,18 +231,24 @@ static bool ot_prepare(const TechContext *ctx, void **state, Error *err)
     }
     st->bias = smap_bias(p, ctx->scene);
     st->slices = (int)p[P_SLICES];
+    st->filter = (int)p[P_FILTER];
     st->stride = map->res + 1;
-    size_t entries = (size_t)map->num_faces * (st->slices + 1) * st->stride * st->stride;
-    double gib = (double)entries * sizeof(uint32_t) / (1u << 30);
-    if (entries * sizeof(uint32_t) > SHADOWMAP_MAX_BYTES) {
+    st->tables = 1 + (st->filter == FILTER_SAT ? st->slices : 0);
+    level_layout(st, map->res);
+    size_t sats = (size_t)map->num_faces * st->tables * st->stride * st->stride;
+    size_t floats = (size_t)map->num_faces * st->slices * st->slice_floats;
+    double bytes = (double)sats * sizeof(uint32_t) + (double)floats * sizeof(float), gib = bytes / (1u << 30);
+    if (bytes > (double)SHADOWMAP_MAX_BYTES) {
         free(st);
-        return error_set(err, "occlusion_textures: slices = %d of map_size = %d (%d faces) take %.2f GiB, above the "
-                              "%.0f GiB limit: lower slices or map_size",
-                         (int)p[P_SLICES], map->res, map->num_faces, gib, (double)SHADOWMAP_MAX_BYTES / (1u << 30));
+        return error_set(err, "occlusion_textures: slices = %d, filter = %s of map_size = %d (%d faces) take %.2f GiB, "
+                              "above the %.0f GiB limit: lower slices or map_size, or filter=sat",
+                         (int)p[P_SLICES], filter_names[(int)p[P_FILTER]], map->res, map->num_faces, gib,
+                         (double)SHADOWMAP_MAX_BYTES / (1u << 30));
     }
-    st->sat = calloc(entries, sizeof *st->sat);
-    if (!st->sat) {
-        free(st);
+    st->sat = calloc(sats, sizeof *st->sat);
+    st->level = floats ? malloc(floats * sizeof *st->level) : NULL;
+    if (!st->sat || (floats && !st->level)) {
+        ot_release(st);
         return error_set(err, "occlusion_textures: out of memory for %.2f GiB of slice tables", gib);
     }
     for (int f = 0; f < map->num_faces; f++)
@@ -163,19 +260,76 @@ static bool ot_prepare(const TechContext *ctx, void **state, Error *err)
     return true;
 }
 
-/* The mean of slice k's occupancy over texels [i0, i1] x [j0, j1], clamped to the face. */
+/* The mean of table t's texels over [i0, i1] x [j0, j1] (inside the face). */
+static double sat_mean(const OtState *st, int face, int t, int i0, int j0, int i1, int j1)
+{
+    int n = st->stride;
+    const uint32_t *s = sat_of(st, face, t);
+    double count = (double)s[(size_t)(j1 + 1) * n + i1 + 1] - s[(size_t)j0 * n + i1 + 1] - s[(size_t)(j1 + 1) * n + i0] +
+                   s[(size_t)j0 * n + i0];
+    return count / ((double)(i1 - i0 + 1) * (j1 - j0 + 1));
+}
+
+static int floor_log2(int k)
+{
+    int l = 0;
+    while ((2 << l) <= k) l++;
+    return l;
+}
+
+/* Block start a of n spread from lo to hi (n = 1: lo). */
+static int spread(int lo, int hi, int a, int n) { return n == 1 ? lo : lo + (int)lround((double)a * (hi - lo) / (n - 1)); }
+
+/* The N-buffer estimate: the mean of the level-l blocks (2^l <= the window's
+ * narrower side) at ceil(K / 2^l) starts per axis. */
+static double nbuffer_mean(const OtState *st, int face, int k, int i0, int j0, int i1, int j1)
+{
+    int kx = i1 - i0 + 1, ky = j1 - j0 + 1, l = floor_log2(kx < ky ? kx : ky), b = 1 << l;
+    int nx = (kx + b - 1) / b, ny = (ky + b - 1) / b, res = st->level_res[l];
+    const float *lv = level_of(st, face, k, l);
+    double sum = 0.0;
+    for (int y = 0; y < ny; y++)
+        for (int x = 0; x < nx; x++)
+            sum += lv[(size_t)spread(j0, j1 - b + 1, y, ny) * res + spread(i0, i1 - b + 1, x, nx)];
+    return sum / ((double)nx * ny);
+}
+
+/* The mipmap estimate: bilinear at the window's centre on the level nearest
+ * log2 of its narrower side. */
+static double mipmap_mean(const OtState *st, int face, int k, int i0, int j0, int i1, int j1)
+{
+    int kx = i1 - i0 + 1, ky = j1 - j0 + 1;
+    int l = (int)floor(log2((double)(kx < ky ? kx : ky)) + 0.5);
+    l = l < st->levels ? l : st->levels - 1;
+    int n = st->level_res[l];
+    double scale = ldexp(1.0, -l);
+    double u = 0.5 * (i0 + i1 + 1) * scale - 0.5, v = 0.5 * (j0 + j1 + 1) * scale - 0.5; /* level-l texel centres */
+    int x0 = (int)floor(u), y0 = (int)floor(v);
+    double fx = u - x0, fy = v - y0;
+    int xa = x0 < 0 ? 0 : clamp_index(x0, n), xb = clamp_index(x0 + 1 < 0 ? 0 : x0 + 1, n);
+    int ya = y0 < 0 ? 0 : clamp_index(y0, n), yb = clamp_index(y0 + 1 < 0 ? 0 : y0 + 1, n);
+    const float *lv = level_of(st, face, k, l);
+    double top = (1 - fx) * lv[(size_t)ya * n + xa] + fx * lv[(size_t)ya * n + xb];
+    double bottom = (1 - fx) * lv[(size_t)yb * n + xa] + fx * lv[(size_t)yb * n + xb];
+    return (1 - fy) * top + fy * bottom;
+}
+
+/* Slice k's occupancy mean (k = -1: the NaN texels') over texels
+ * [i0, i1] x [j0, j1], clamped to the face, by the state's filter. */
 static double box_mean(const OtState *st, int face, int k, int i0, int j0, int i1, int j1)
 {
-    int res = st->sm.map->res, n = st->stride;
+    int res = st->sm.map->res;
     i0 = i0 < 0 ? 0 : i0;
     j0 = j0 < 0 ? 0 : j0;
     i1 = i1 >= res ? res - 1 : i1;
     j1 = j1 >= res ? res - 1 : j1;
     if (i0 > i1 || j0 > j1) return 0.0; /* off the face: nothing known to occlude */
-    const uint32_t *s = sat_of(st, face, k);
-    double count = (double)s[(size_t)(j1 + 1) * n + i1 + 1] - s[(size_t)j0 * n + i1 + 1] - s[(size_t)(j1 + 1) * n + i0] +
-                   s[(size_t)j0 * n + i0];
-    return count / ((double)(i1 - i0 + 1) * (j1 - j0 + 1));
+    if (k < 0) return sat_mean(st, face, 0, i0, j0, i1, j1);
+    switch (st->filter) {
+    case FILTER_SAT: return sat_mean(st, face, 1 + k, i0, j0, i1, j1);
+    case FILTER_NBUFFER: return nbuffer_mean(st, face, k, i0, j0, i1, j1);
+    default: return mipmap_mean(st, face, k, i0, j0, i1, j1);
+    }
 }
 
 /* A window's first and last texel: K = max(1, 2 half) texels centred on c. */
@@ -206,7 +360,7 @@ static float visibility(const OtState *st, const SmapReceiver *r)
         int i0, i1, j0, j1;
         window(r->mc.s, backproject_footprint(sf->light.half_x, r_z, bottom) / sf->dx, &i0, &i1);
         window(r->mc.t, backproject_footprint(sf->light.half_y, r_z, bottom) / sf->dy, &j0, &j1);
-        unknown = unknown || box_mean(st, face, st->slices, i0, j0, i1, j1) > 0.0; /* a caster of unknown slice */
+        unknown = unknown || box_mean(st, face, -1, i0, j0, i1, j1) > 0.0; /* a caster of unknown slice */
         v *= 1.0 - box_mean(st, face, k, i0, j0, i1, j1);
     }
     return unknown && v > 0.0 ? NAN : (float)v;
@@ -229,8 +383,8 @@ const Technique tech_occlusion_textures = {
     .name = "occlusion_textures",
     .family = "soft",
     .source = "course §5.2.5 (Eisemann & Décoret 2006, occlusion textures)",
-    .summary = "S depth slices of the map's casters as binary textures, each box-filtered by a summed-area table "
-               "over the light's footprint on its plane; V the product over the slices in front of p",
+    .summary = "S depth slices of the map's casters as binary textures, each box-filtered (N-buffer, summed-area "
+               "table or mipmap) over the light's footprint on its plane; V the product over the slices in front of p",
     .params = ot_params,
     .num_params = (int)(sizeof ot_params / sizeof ot_params[0]),
     .resources = ot_resources,
