@@ -161,6 +161,9 @@ plot x with lines dashtype 2 title 'ideal'"
     echo "Constant time in K with summed-area tables (target: largest K within 1.2x of the smallest):"
     echo
     table constant_time.csv technique settings prefilter K_min K_max frame_min_ms frame_max_ms ratio within light threads load_1min
+    echo "Constant in the light's size (the prefiltered PCSS family and occlusion textures claim it; pcss grows):"
+    echo
+    table light_size.csv technique map_size radius_small radius_large frame_small_ms frame_large_ms ratio within scene threads load_1min
     echo "## 4. Sweep reuse (target <= 1.1; cached references not retraced)"
     echo
     table sweep_reuse.csv sweep technique points sweep_ms one_build_ms evals_ms ratio builds reuses within threads load_1min

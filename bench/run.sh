@@ -55,6 +55,8 @@ run "$bin/techniques" --only constant --threads "$threads" --repeat "$repeat" -o
 # where a SAT window loses precision at large exponents) costs K^2.
 run "$bin/techniques" --only constant -t esm -p classifier=none -p exponent=20 --threads "$threads" \
     --repeat "$repeat" -o "$out"
+# constant in the light's size (course §5.2.2, §5.2.5): every soft technique on the bunny, radius 0.05 and 0.8
+run "$bin/techniques" --only lightsize $q --threads "$threads" --repeat "$repeat" -o "$out" scenes/bunny.lua
 
 step 4 "sweep reuse"
 run "$bin/sweep_reuse" --threads "$threads" -o "$out"

@@ -13,11 +13,16 @@
  *     choice named sat) at K = its minimum and maximum: frame time at the
  *     largest K within 1.2x of the smallest (the papers' claim);
  *   threads: each technique's evaluation, and the Embree reference, on the
- *     curve 1, 2, 4, ... N threads (bench.h's BenchCurve).
+ *     curve 1, 2, 4, ... N threads (bench.h's BenchCurve);
+ *   lightsize: every soft technique that handles sphere lights at light 1's
+ *     radius 0.05 and 0.8 (map_size 2048 where it has one; --quick: 1024):
+ *     frame time at 0.8 over 0.05, against the 1.2 bound the constant-time
+ *     claims name (prefiltered PCSS, CSSM, VSSM, ESSM, moment soft shadows:
+ *     course §5.2.2; occlusion textures: §5.2.5), `pcss` beside them growing.
  * -p NAME=VALUE sets that parameter in every technique that has one (the
  * rows' `settings` column lists what was set).
- * Rows: DIR/growth.csv, DIR/constant_time.csv, DIR/threads_eval.csv.
- * Usage: techniques [--only growth|constant|threads] [-t TECH]... [-p NAME=VALUE]...
+ * Rows: DIR/growth.csv, DIR/constant_time.csv, DIR/threads_eval.csv, DIR/light_size.csv.
+ * Usage: techniques [--only growth|constant|threads|lightsize] [-t TECH]... [-p NAME=VALUE]...
  *                   [--threads N] [--repeat R] [--quick] [-o DIR] [SCENE] */
 #include <math.h>
 #include <omp.h>
@@ -36,6 +41,8 @@
 #define GROWTH_HEADER "technique,axis,value,frame_ms,eval_ms,build_ms,resources_built,note," WHERE_HEADER
 #define CONSTANT_HEADER "technique,prefilter,K_min,K_max,frame_min_ms,frame_max_ms,ratio,bound,within," WHERE_HEADER
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup," WHERE_HEADER
+#define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
+                          WHERE_HEADER
 
 typedef struct Options {
     BenchCommon c;
@@ -104,7 +111,8 @@ static bool parse_options(int argc, char **argv, Options *o)
 {
     *o = (Options){.quick = false};
     if (!bench_parse(argc, argv, 3, &o->c, own_option, o) || o->c.num_scenes > 1) return false;
-    if (o->only && strcmp(o->only, "growth") != 0 && strcmp(o->only, "constant") != 0 && strcmp(o->only, "threads") != 0)
+    if (o->only && strcmp(o->only, "growth") != 0 && strcmp(o->only, "constant") != 0 &&
+        strcmp(o->only, "threads") != 0 && strcmp(o->only, "lightsize") != 0)
         return false;
     for (int i = 0; i < o->num_techs; i++) {
         Error err;
@@ -331,6 +339,51 @@ static bool constant_time(const Options *o, Subject *sj, Error *err)
     return append(o, "constant_time.csv", CONSTANT_HEADER, row, err);
 }
 
+/* ---- constant in the light's size -------------------------------------------- */
+
+static bool soft_on_spheres(const Technique *t)
+{
+    return strcmp(t->family, "soft") == 0 && (t->lights & LIGHT_BIT(LIGHT_SPHERE));
+}
+
+/* Frame time at one radius of light 1 (a sphere on the bench's scenes). */
+static bool at_radius(const Options *o, Subject *sj, const double *params, double radius, Point *p, char *end,
+                      size_t n, Error *err)
+{
+    char r[64];
+    snprintf(r, sizeof r, "lights[1].radius=%g", radius);
+    const char *ov[] = {"camera.width=320", "camera.height=240", r};
+    Lab *lab = open_lab(o, sj, ov, 3, err);
+    if (!lab) return false;
+    bool ok = measure(lab, sj->t, params, o->c.repeat, p, err);
+    if (ok && end) where(sj, lab_scene(lab), o->c.threads, end, n);
+    lab_close(lab);
+    return ok;
+}
+
+static bool light_size(const Options *o, Subject *sj, Error *err)
+{
+    static const double small = 0.05, large = 0.8;
+    const Technique *t = sj->t;
+    double params[TECH_MAX_PARAMS];
+    memcpy(params, sj->params, sizeof params);
+    int ms = tech_param_index(t, "map_size"), map_size = o->quick ? 1024 : 2048;
+    if (ms >= 0) params[ms] = map_size;
+    announce(o, sj, "lightsize");
+    Point lo, hi;
+    char end[1024];
+    if (!at_radius(o, sj, params, small, &lo, NULL, 0, err) ||
+        !at_radius(o, sj, params, large, &hi, end, sizeof end, err))
+        return false;
+    double ratio = hi.frame_s / lo.frame_s;
+    char row[2048];
+    snprintf(row, sizeof row, "%s,%d,%g,%g,%.4f,%.4f,%.3f,%.1f,%s,%s", t->name, ms >= 0 ? map_size : 0, small, large,
+             lo.frame_s * 1e3, hi.frame_s * 1e3, ratio, CONSTANT_BOUND, ratio <= CONSTANT_BOUND ? "yes" : "no", end);
+    printf("  %-18s radius %g: %.3f ms, radius %g: %.3f ms, ratio %.2f (bound %.1f)%s\n", t->name, small,
+           lo.frame_s * 1e3, large, hi.frame_s * 1e3, ratio, CONSTANT_BOUND, ratio <= CONSTANT_BOUND ? "" : "  OVER");
+    return append(o, "light_size.csv", LIGHT_SIZE_HEADER, row, err);
+}
+
 /* ---- thread scaling ------------------------------------------------------------ */
 
 typedef struct Scaling {
@@ -411,6 +464,7 @@ static bool bench_technique(const Options *o, const Technique *t)
     if (ok && part(o, "growth")) ok = growth(o, &sj, &err);
     if (ok && part(o, "constant") && has_sat(t)) ok = constant_time(o, &sj, &err);
     if (ok && part(o, "threads")) ok = scaling(o, &sj, &err);
+    if (ok && part(o, "lightsize") && soft_on_spheres(t)) ok = light_size(o, &sj, &err);
     if (sj.refused) printf("%s: %d growth point(s) REFUSED (growth.csv's note column says why)\n", t->name, sj.refused);
     if (!ok) fprintf(stderr, "techniques: %s: FAILED: %s\n", t->name, err.msg);
     return ok;
@@ -420,7 +474,7 @@ int main(int argc, char **argv)
 {
     Options o;
     if (!parse_options(argc, argv, &o))
-        return bench_usage("techniques [--only growth|constant|threads] [-t TECH]... [-p NAME=VALUE]... "
+        return bench_usage("techniques [--only growth|constant|threads|lightsize] [-t TECH]... [-p NAME=VALUE]... "
                            "[--threads N] [--repeat R] [--quick] [-o DIR] [SCENE]");
     omp_set_num_threads(o.c.threads);
     rt_set_threads(o.c.threads);
