@@ -381,5 +381,5 @@ sl.write_file(OUT .. "/combinations.md", "# Occluder fusion: the reference again
               table.concat(combo_md, "\n") .. "\n")
 if not quiet then io.stdout:write(table.concat(md, "\n"), "\n\n", table.concat(combo_md, "\n"), "\n") end
 reproduce.compare(claims, { out = OUT, title = "Soft-shadow failure cases (course Figs. 1.6, 5.1, 5.3, 5.4)",
-                            note = setting .. "; the reference's own noise enters each combination.", quiet = quiet })
+                            note = setting .. "; the reference's own noise enters each combination." })
 log("soft-failures: %s/failures.md, failures.csv, combinations.md, reproduction.md (%.0f s)", OUT, seconds)
