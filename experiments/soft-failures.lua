@@ -196,7 +196,7 @@ local function planar_case()
     log("%-18s planar-occluder   lit %.3f (%d)  umbra %.3f (%d)  penumbra x%.3f", t, lit_worst, lit_n, umbra_worst,
         umbra_n, ratio)
     if t == "pcss" then
-      local SCHEMATIC = reproduce.factor(2, "Figs. 5.3's values count 1 or 2 of 4 filter samples in a schematic; " ..
+      local SCHEMATIC = reproduce.factor(2, "Fig. 5.3's values count 1 or 2 of 4 filter samples in a schematic; " ..
                                             "a scene can agree in size only")
       claims[#claims + 1] = { item = "pcss: worst lit point", quantity = "shading (1 - V)", paper = 0.25,
                               measured = lit_worst, rule = SCHEMATIC, source = "course §5.2.2.1, Fig. 5.3 (left)" }
