@@ -273,6 +273,7 @@ run_repro() { # run_repro EXPERIMENT ARGS...: its output in $R/EXPERIMENT.log, i
     run_repro course-fig2.3-midpoint $TINYQ
     run_repro course-fig4.5-vsm-bleeding --map-size 128 $TINYQ
     run_repro fig3-7-aliasing-vs-z --map-size 256
+    run_repro soft-failures --set camera.width=40 --set camera.height=30 --samples 16 --quiet --threads 1
 ) &
 lane=$!
 run_repro seed000-fig3 $TINYQ
@@ -289,7 +290,7 @@ wait "$lane"
 for e in seed000-fig3 seed001-adaptive-area seed002-single-sample seed003-shadow-width seed003-table1 \
          course-fig2.2-bias course-fig2.3-midpoint course-fig4.3-pcf-umbra course-fig4.5-vsm-bleeding \
          course-fig4.7-csm-terms fig3-7-aliasing-vs-z fig3-10-12-partitions fig3-13-storage-factor \
-         course-fig2.4-2.10-shadow-volumes exact-soft-vs-rays; do
+         course-fig2.4-2.10-shadow-volumes exact-soft-vs-rays soft-failures; do
     expect "${e}_reproduces" 0 "paper against measured" "reproduction:" -- \
         sh -c 'cat "$1.log"; exit "$(cat "$1.rc" 2>/dev/null || echo 1)"' sh "$R/$e"
 done
@@ -300,6 +301,8 @@ expect seed000_titles_follow_samples 0 "against a 4-sample reference" "reference
     "against a 64-sample reference (the paper" -- cat "$R/seed000-fig3/index.html" "$R/seed000-fig3/ref64/index.html"
 expect seed001_title_and_table_follow_the_view 0 "under a textured light, 32x24" "by subdivisions (32x24)" -- \
     cat "$R/seed001-adaptive-area/index.html" "$R/seed001-adaptive-area/table2.md"
+figure soft_failures_reference_follows_fig_1_6 "$R/soft-failures/reproduction.csv" measured 0 0.99 \
+    item~"the reference against the rule"
 figure seed001_unsubdivided_share "$R/seed001-adaptive-area/reproduction.csv" measured 20 90 item~"no subdivision"
 figure seed001_test_ratios "$R/seed001-adaptive-area/reproduction.csv" measured 0.5 5 quantity~"tests per pixel"
 figure seed002_small_balls_err_more "$R/seed002-single-sample/reproduction.csv" measured 1 1000 quantity~"rho" --hold

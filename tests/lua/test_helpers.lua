@@ -481,6 +481,66 @@ test("reproduce_judges_each_rule_and_writes_one_csv_row_per_item", function()
                                             { out = dir, title = "T", quiet = true }) end, "source")
 end)
 
+-- Occluder fusion (lua/shadowlab/fusion.lua, experiments/soft-failures.lua):
+-- the rules of course Fig. 1.6 and the nearest-rule classification, on
+-- synthetic visibilities where the answer is known.
+test("fusion_combines_occlusions_by_sum_product_and_max", function()
+  local fusion = require "shadowlab.fusion"
+  local c = fusion.combine(0.75, 0.5) -- occlusions 0.25 and 0.5
+  assert(math.abs(c.sum - 0.25) < 1e-12 and math.abs(c.product - 0.375) < 1e-12 and c.max == 0.5,
+         string.format("sum %g product %g max %g", c.sum, c.product, c.max))
+  assert(fusion.combine(0.2, 0.3).sum == 0, "the sum of occlusions clamps at no light left")
+  assert(fusion.in_region(0.5, 0.5) and not fusion.in_region(1, 0.5) and not fusion.in_region(0.5, 0),
+         "only samples both occluders alone leave in penumbra can tell the rules apart")
+  expect_error(function() fusion.combine(0 / 0, 0.5) end, "v1", "finite")
+end)
+
+test("fusion_classifies_an_estimate_as_the_rule_it_follows", function()
+  local fusion = require "shadowlab.fusion"
+  -- truth: the product (partial overlap); v1, v2 over a grid of penumbra values
+  local function samples(rule, noise)
+    local out = {}
+    for i = 1, 9 do
+      for j = 1, 9 do
+        local c = fusion.combine(i / 10, j / 10)
+        local s = { truth = c.product, sum = c.sum, product = c.product, max = c.max }
+        s.estimate = s[rule] + noise * (((i * 7 + j * 3) % 5) - 2) / 2 -- a deterministic +-noise
+        out[#out + 1] = s
+      end
+    end
+    return out
+  end
+  for _, rule in ipairs({ "sum", "max" }) do
+    local label, rmse, n = fusion.classify(samples(rule, 0.01))
+    assert(label == rule, rule .. " classified as " .. label)
+    assert(n == 81 and rmse[rule] < rmse.truth, rule .. ": rmse " .. rmse[rule])
+  end
+  -- the product is the truth here: both names, since the scene cannot tell them apart
+  assert(fusion.classify(samples("product", 0.01)) == "truth=product")
+  local label, _, _, bias = fusion.classify(samples("sum", 0))
+  assert(label == "sum" and bias < 0, "the sum is darker than the product: signed error " .. bias)
+  local none, rmse = fusion.classify({})
+  assert(none == "-" and rmse.truth ~= rmse.truth, "no samples: not measured (NaN), never 0")
+  expect_error(function()
+    fusion.classify({ { estimate = 0 / 0, truth = 0.5, sum = 0.5, product = 0.5, max = 0.5 } })
+  end, "samples[1].estimate")
+end)
+
+test("scenefile_writes_a_scene_the_engine_reads_back_exactly", function()
+  local scenefile = require "shadowlab.scenefile"
+  local scene = scenefile.load(sl.root .. "/scenes/parallel-planes.lua")
+  scene.lights[1].width, scene.name = 0.1, "derived"
+  local path = tmp .. "/derived.lua"
+  scenefile.write(path, scene, "a test")
+  local back = scenefile.load(path)
+  assert(deep_equal(back, scene), "the written scene reads back equal")
+  local lab = sl.open(path, small)
+  assert(lab:info().name == "derived" and lab:info().lights[1].type == "rect")
+  lab:close()
+  scene.objects[1].height_fn = function() return 0 end
+  expect_error(function() scenefile.write(path, scene) end, "objects[1].height_fn", "function")
+end)
+
 for _, t in ipairs(tests) do
   local ok, err = pcall(t.fn)
   if ok then print("ok   " .. t.name) else
