@@ -11,7 +11,7 @@
  *   - its failure, occluder fusion on overlap.lua (course Figs. 1.7, 5.19):
  *     signed error measured, the umbra under the overlap leaking.
  * 128 x 96 and 160 x 120 views, 256^2-1024^2 maps, 64- and 256-sample
- * stratified references; 0.6 s at -O2 (load 0.3 on 2 cores). */
+ * stratified references; 0.6 s at -O2, 8.7 s under ASan+UBSan (load 0.3-1 on 2 cores). */
 #include <math.h>
 #include "fixtures.h"
 #include "signed_error.h"
