@@ -227,7 +227,8 @@ const Technique tech_vssm = {
     .family = "soft",
     .source = "Yang, Dong, Feng, Seidel & Kautz 2010 (Variance Soft Shadow Mapping, PG 2010); course §5.2.2.2 (SAT)",
     .summary = "PCSS from one summed-area table of u, u^2: Yang's blocker mean from Chebyshev's bound, Chebyshev "
-               "over the penumbra window; windows whose mean lies at or behind the receiver split 2 x 2 up to split_depth",
+               "over the penumbra window; windows whose mean lies at or behind the receiver split 2 x 2 up to "
+               "split_depth",
     .params = vssm_params,
     .num_params = (int)(sizeof vssm_params / sizeof vssm_params[0]),
     .resources = vssm_resources,
