@@ -105,6 +105,14 @@ local WINDOW_FUSION = "course §4.2.1 (one-tailed Chebyshev bound): a window hol
                       "course Fig. 4.5's setting"
 EXPECTED.pcss_prefiltered = { contact = NONPLANAR_RECEIVER, teapot = NONPLANAR_RECEIVER, overlap = WINDOW_FUSION }
 EXPECTED.evssm = { contact = NONPLANAR_RECEIVER, teapot = NONPLANAR_RECEIVER }
+-- vssm at 160x120 (64 samples): umbra leak contact 0.172, teapot 0.208, overlap 0.110 (pcss_prefiltered 0.172,
+-- 0.210, 0.110; bunny 0.081 against 0.093). Its kernel subdivision splits only windows whose mean lies at or behind
+-- the receiver; contact's umbra leak is the same at split_depth 0 to 4 (0.172): there the receiver lies behind its
+-- windows' means, where Chebyshev's bound is loose, not blind.
+local CHEBYSHEV_SLACK = "Yang et al. 2010 (vssm.c): kernels are split only where the receiver is not behind the " ..
+                        "window's mean (Chebyshev blind); where it is behind, the one-tailed bound over blockers and " ..
+                        "the receiver's own tilted or curved floor is loose (course §4.2.1's bleeding) and the umbra leaks"
+EXPECTED.vssm = { contact = CHEBYSHEV_SLACK, teapot = CHEBYSHEV_SLACK, overlap = WINDOW_FUSION }
 -- cssm on the bunny: umbra leak 0.317 at 48x36 (16 samples), unchanged by the contact fixes; docs/filtered-soft.md
 -- measures +0.27 to +0.30 at 1024^2.
 EXPECTED.cssm = {

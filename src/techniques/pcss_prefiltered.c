@@ -15,7 +15,7 @@
  * 1 - f for a blocked fraction f, and z_occ the occluder's depth, so the
  * result is the exhaustive PCSS box (pcss.c) up to rounding. VSSM's kernel
  * subdivision for u <= mu_s with blockers present (non-planar receivers) is
- * not done: those receivers are called lit (issue 16's `vssm`). */
+ * not done here: those receivers are called lit (vssm.c splits them). */
 #include <stdlib.h>
 #include "techniques/filtsoft.h"
 

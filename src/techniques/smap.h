@@ -189,13 +189,20 @@ typedef struct SmapReceiver {
  * false when the sample falls outside the map (the technique decides: lit). */
 bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_geom_world, SmapReceiver *r);
 
+/* Reference depth at map point (s, t) of the receiver's face (texel units:
+ * texel i covers [i, i + 1]): the receiver plane's there, else r->ref. */
+static inline double smap_ref_at_point(const SmapReceiver *r, double s, double t)
+{
+    if (!r->plane) return r->ref;
+    double g = r->g0 + r->gs * (s - r->mc.s) + r->gt * (t - r->mc.t);
+    double d = r->reciprocal ? (g > 0.0 ? 1.0 / g : INFINITY) : g;
+    return d - r->bias;
+}
+
 /* Reference depth to compare with texel (i, j) of the receiver's face. */
 static inline double smap_ref_at(const SmapReceiver *r, int i, int j)
 {
-    if (!r->plane) return r->ref;
-    double g = r->g0 + r->gs * (i + 0.5 - r->mc.s) + r->gt * (j + 0.5 - r->mc.t);
-    double d = r->reciprocal ? (g > 0.0 ? 1.0 / g : INFINITY) : g;
-    return d - r->bias;
+    return smap_ref_at_point(r, i + 0.5, j + 0.5);
 }
 
 /* The shadow test of course §2.1: lit (1) unless the reference lies behind
