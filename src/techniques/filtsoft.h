@@ -96,4 +96,20 @@ double filtsoft_fourier_step(const double *coef, int terms, const double *m, dou
 /* The clamp of v to [0, 1], NaN kept (so a broken estimate shows). */
 static inline double filtsoft_unit_clamp(double v) { return v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v; }
 
+/* PCSS from one summed-area table of u and u^2 read through Chebyshev's
+ * bound, with Yang et al. 2010's kernel subdivision to split_depth levels
+ * (vssm.c, where the estimate is written out); pcss_prefiltered is it with
+ * split_depth 0, the same function. */
+typedef struct ChebSoft {
+    FiltSoft fs;
+    const Prefiltered *sat;
+    double min_variance, lit_eps;
+    int split_depth;
+} ChebSoft;
+/* Acquire the map, pyramid and SAT (f64 when f64) for technique `tech`. */
+bool chebsoft_init(ChebSoft *cs, const TechContext *ctx, double max_radius, bool receiver_plane, bool f64,
+                   double min_variance, double lit_eps, int split_depth, const char *tech, Error *err);
+/* The receiver's visibility, and in *deepest the deepest level split. */
+double chebsoft_visibility(const ChebSoft *cs, const SmapReceiver *r, int *deepest);
+
 #endif

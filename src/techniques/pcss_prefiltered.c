@@ -15,7 +15,9 @@
  * 1 - f for a blocked fraction f, and z_occ the occluder's depth, so the
  * result is the exhaustive PCSS box (pcss.c) up to rounding. VSSM's kernel
  * subdivision for u <= mu_s with blockers present (non-planar receivers) is
- * not done here: those receivers are called lit (vssm.c splits them). */
+ * not done here: those receivers are called lit (vssm.c splits them). The
+ * estimate is vssm's at split_depth 0: one function, chebsoft_visibility
+ * (filtsoft.h, written out in vssm.c). */
 #include <stdlib.h>
 #include "techniques/filtsoft.h"
 
@@ -41,22 +43,13 @@ FILTER_CHECK_TABLE(pcss_prefiltered_params);
 static const char *const pcss_prefiltered_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", "moments",
                                                          "sat", NULL};
 
-typedef struct PpState {
-    FiltSoft fs;
-    const Prefiltered *sat;
-    double min_variance, lit_eps;
-} PpState;
-
 static bool pp_prepare(const TechContext *ctx, void **state, Error *err)
 {
     const double *p = ctx->params;
-    PpState *st = calloc(1, sizeof *st);
+    ChebSoft *st = calloc(1, sizeof *st);
     if (!st) return error_set(err, "out of memory");
-    st->min_variance = p[P_MIN_VAR];
-    st->lit_eps = p[P_LIT_EPS];
-    MomentSpec spec = {.warp = WARP_POWERS, .order = 2, .f64 = (int)p[P_PRECISION] == 0};
-    if (!filtsoft_init(&st->fs, ctx, p[P_MAX_RADIUS], false, "pcss_prefiltered", err) ||
-        !(st->sat = filtsoft_sat(ctx, &st->fs, spec, err))) {
+    if (!chebsoft_init(st, ctx, p[P_MAX_RADIUS], false, (int)p[P_PRECISION] == 0, p[P_MIN_VAR], p[P_LIT_EPS], 0,
+                       "pcss_prefiltered", err)) {
         free(st);
         return false;
     }
@@ -64,30 +57,15 @@ static bool pp_prepare(const TechContext *ctx, void **state, Error *err)
     return true;
 }
 
-static double pp_visibility(const PpState *st, const SmapReceiver *r)
-{
-    FsWindow ws;
-    double z_min; /* the search window's nearest depth, linear */
-    if (!filtsoft_search(&st->fs, r, &ws, &z_min)) return 1.0;
-    double u = filtsoft_unit(&st->fs, r), m[2], z_occ;
-    if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, ws.hx, ws.hy, 2, m)) return NAN; /* a NaN window */
-    double p_search = chebyshev_upper(m[0], m[1], u, st->min_variance);
-    if (!filtsoft_blocker_mean(m[0], p_search, u, st->lit_eps, &z_occ)) return 1.0;
-    z_occ = filtsoft_unit_clamp(z_occ); /* mu_s and u lie in [0, 1]: rounding only */
-    FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_occ), z_min);
-    if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 2, m)) return NAN;
-    return chebyshev_upper(m[0], m[1], u, st->min_variance);
-}
-
 static void pp_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
 {
-    const PpState *st = state;
+    const ChebSoft *st = state;
     for (int s = begin; s < end; s++) {
         if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
         SmapReceiver r;
         double v = 1.0;
         if (smap_receiver(st->fs.sm.map, &st->fs.bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r))
-            v = pp_visibility(st, &r);
+            v = chebsoft_visibility(st, &r, &(int){0});
         tech_store(ctx, out, begin, s, (float)filtsoft_unit_clamp(v));
     }
 }

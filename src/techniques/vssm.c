@@ -42,8 +42,8 @@
  *            [derived: Yang's formula per sub-kernel, weighted by its
  *            blocked fraction]; a sub-kernel with d_k <= z_mean_k adds no
  *            blockers (P_k = 1). One recursion (kernel_estimate) serves both.
- * With split_depth 0 and receiver_plane off this is pcss_prefiltered, bit
- * for bit (the same expressions); a leaf still at d <= z_mean with
+ * With split_depth 0 this is pcss_prefiltered (which calls
+ * chebsoft_visibility, filtsoft.h, with split_depth 0); a leaf still at d <= z_mean with
  * blockers in front keeps Chebyshev's 1: what subdivision cannot resolve.
  * The paper's text beyond its abstract was not at hand: the criterion
  * d <= z_mean, the 2 x 2 split and the combinations above follow issue 16's
@@ -101,22 +101,22 @@ static const char *const vssm_resources[] = {"shadow_map", "minmax_pyramid", "vi
 /* the deepest subdivision level either window reached (0: none) */
 static const char *const vssm_aux[] = {"split_level", NULL};
 
-typedef struct VssmState {
-    FiltSoft fs;
-    const Prefiltered *sat;
-    double min_variance, lit_eps;
-    int split_depth;
-} VssmState;
+bool chebsoft_init(ChebSoft *cs, const TechContext *ctx, double max_radius, bool receiver_plane, bool f64,
+                   double min_variance, double lit_eps, int split_depth, const char *tech, Error *err)
+{
+    *cs = (ChebSoft){.min_variance = min_variance, .lit_eps = lit_eps, .split_depth = split_depth};
+    MomentSpec spec = {.warp = WARP_POWERS, .order = 2, .f64 = f64};
+    return filtsoft_init(&cs->fs, ctx, max_radius, receiver_plane, tech, err) &&
+           (cs->sat = filtsoft_sat(ctx, &cs->fs, spec, err));
+}
 
 static bool vssm_prepare(const TechContext *ctx, void **state, Error *err)
 {
     const double *p = ctx->params;
-    VssmState *st = calloc(1, sizeof *st);
+    ChebSoft *st = calloc(1, sizeof *st);
     if (!st) return error_set(err, "out of memory");
-    *st = (VssmState){.min_variance = p[P_MIN_VAR], .lit_eps = p[P_LIT_EPS], .split_depth = (int)p[P_SPLIT_DEPTH]};
-    MomentSpec spec = {.warp = WARP_POWERS, .order = 2, .f64 = (int)p[P_PRECISION] == 0};
-    if (!filtsoft_init(&st->fs, ctx, p[P_MAX_RADIUS], true, "vssm", err) ||
-        !(st->sat = filtsoft_sat(ctx, &st->fs, spec, err))) {
+    if (!chebsoft_init(st, ctx, p[P_MAX_RADIUS], true, (int)p[P_PRECISION] == 0, p[P_MIN_VAR], p[P_LIT_EPS],
+                       (int)p[P_SPLIT_DEPTH], "vssm", err)) {
         free(st);
         return false;
     }
@@ -129,7 +129,7 @@ typedef struct Kernel { double s, t, hx, hy; } Kernel;
 
 /* One receiver's query, and the deepest level split for it. */
 typedef struct VssmQuery {
-    const VssmState *st;
+    const ChebSoft *st;
     const SmapReceiver *r;
     int deepest;
 } VssmQuery;
@@ -191,7 +191,7 @@ static KernelEstimate kernel_estimate(VssmQuery *q, Kernel k, int level)
  * z_avg = (z_mean - P d) / (1 - P), summed over sub-kernels (header);
  * false when the blocked fraction 1 - P is below lit_threshold (the caller's
  * "lit"; a NaN passes on into *z_avg). */
-static bool blocker_depth(const VssmState *st, KernelEstimate e, double *z_avg)
+static bool blocker_depth(const ChebSoft *st, KernelEstimate e, double *z_avg)
 {
     double blocked = 1.0 - e.lit;
     if (blocked < st->lit_eps) return false;
@@ -199,7 +199,7 @@ static bool blocker_depth(const VssmState *st, KernelEstimate e, double *z_avg)
     return true;
 }
 
-static double vssm_visibility(const VssmState *st, const SmapReceiver *r, int *deepest)
+double chebsoft_visibility(const ChebSoft *st, const SmapReceiver *r, int *deepest)
 {
     FsWindow ws;
     double z_min; /* the search window's nearest depth, linear */
@@ -217,14 +217,14 @@ static double vssm_visibility(const VssmState *st, const SmapReceiver *r, int *d
 
 static void vssm_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
 {
-    const VssmState *st = state;
+    const ChebSoft *st = state;
     for (int s = begin; s < end; s++) {
         if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
         SmapReceiver r;
         double v = 1.0;
         int deepest = 0;
         if (smap_receiver(st->fs.sm.map, &st->fs.bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r))
-            v = vssm_visibility(st, &r, &deepest);
+            v = chebsoft_visibility(st, &r, &deepest);
         tech_store(ctx, out, begin, s, (float)filtsoft_unit_clamp(v));
         if (ctx->aux) ctx->aux[s] = (float)deepest;
     }
