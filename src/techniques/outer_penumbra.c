@@ -125,6 +125,9 @@ static void outer_release(void *state)
     free(st);
 }
 
+/* Floats per texel of the light-space buffer: smoothies' alpha and depth, or I. */
+static int buffer_floats(OuterKind kind) { return kind == OUTER_SMOOTHIES ? 2 : 1; }
+
 /* ---- projecting the silhouette onto a face ------------------------------ */
 
 /* Tangent coordinates and depth of a face-view point. */
@@ -233,11 +236,12 @@ static bool draw_buffer(OuterState *st, const Silhouette *sil, Error *err)
     const ShadowMap *m = st->sm.map;
     size_t texels = (size_t)m->num_faces * (size_t)m->res * (size_t)m->res;
     st->value = malloc(sizeof *st->value * texels);
-    st->depth = st->kind == OUTER_SMOOTHIES ? malloc(sizeof *st->depth * texels) : NULL;
+    st->depth = buffer_floats(st->kind) == 2 ? malloc(sizeof *st->depth * texels) : NULL;
     FaceEdge *edges = malloc(sizeof *edges * (size_t)(sil->num_edges > 0 ? sil->num_edges : 1));
-    if (!st->value || (st->kind == OUTER_SMOOTHIES && !st->depth) || !edges) {
+    if (!st->value || (buffer_floats(st->kind) == 2 && !st->depth) || !edges) {
         free(edges);
-        return error_set(err, "out of memory: the %s buffer of %zu texels", st->kind == OUTER_SMOOTHIES ? "smoothie" : "penumbra map", texels);
+        return error_set(err, "out of memory: the %s buffer of %zu texels",
+                         st->kind == OUTER_SMOOTHIES ? "smoothie" : "penumbra map", texels);
     }
     for (size_t k = 0; k < texels; k++) {
         st->value[k] = st->kind == OUTER_SMOOTHIES ? 1.0f : 0.0f;
@@ -269,15 +273,29 @@ static double silhouette_distance(const Silhouette *sil, const Light *light)
 
 /* ---- prepare and evaluate ------------------------------------------------- */
 
+/* The hard map and the buffer beside it together stay under the cap on
+ * shadow maps, checked before either is built. */
+static bool check_bytes(const Light *light, const ShadowMapSpec *spec, OuterKind kind, Error *err)
+{
+    size_t map = shadowmap_bytes_for(light, spec);
+    size_t texels = map / sizeof(float), bytes = map + texels * (size_t)buffer_floats(kind) * sizeof(float);
+    if (bytes <= SHADOWMAP_MAX_BYTES) return true;
+    return error_set(err, "map_size %d: the map and its light-space buffer need %.2f GiB, above the %.0f GiB "
+                          "cap on shadow maps (map_size up to %d here)",
+                     spec->res, (double)bytes / (1 << 30), (double)SHADOWMAP_MAX_BYTES / (1 << 30),
+                     (int)floor(spec->res * sqrt((double)SHADOWMAP_MAX_BYTES / (double)bytes)));
+}
+
 static bool outer_prepare(const TechContext *ctx, OuterKind kind, const char *name, void **state, Error *err)
 {
     const double *p = ctx->params;
+    ShadowMapSpec spec = smap_spec(p);
+    if (!check_bytes(ctx->light, &spec, kind, err)) return false;
     OuterState *st = calloc(1, sizeof *st);
     if (!st) return error_set(err, "out of memory");
     st->kind = kind;
     st->bias = smap_bias(p, ctx->scene);
     st->light_radius = 0.5 * outer_light_diameter(ctx->light);
-    ShadowMapSpec spec = smap_spec(p);
     const ShadowMap *map = res_shadow_map(ctx->rm, ctx->scene, ctx->light_index, &spec, err);
     const Silhouette *sil = map && softmap_frames(&st->sm, map, ctx->light, name, err)
                                 ? res_silhouette(ctx->rm, ctx->scene, ctx->light_index, err)
