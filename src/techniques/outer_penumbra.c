@@ -28,9 +28,10 @@
  * §5.3.1 [OWN]; measured in test_outer_penumbra and
  * experiments/course-fig5.14-outer-penumbra.lua).
  *
- * Formulas. The papers were not available to check beyond the course's
- * summary and the formulas above (from the course, seed 002, and the papers'
- * statements as summarised in issue 14); what follows is marked [derived].
+ * Formulas. The papers' texts were not available here (a search of the
+ * stored pages found the smoothies paper's abstract, not its formulas): the
+ * two above are the papers' as the lab's task for issue 14 states them,
+ * beside course §5.3.1 and seed 002; what follows is marked [derived].
  * The frame is a perspective face's (softmap.h): tangent coordinates
  * (x, y) / z at unit depth, depth z along the face's axis, world units.
  *  - Along a projected edge 1/z is affine in the tangent plane, so a point
@@ -50,8 +51,8 @@
  *    (outer_light_diameter). At width 1 a smoothie at depth z_c spans D
  *    (world units), so alpha' reaches 1 exactly where Parker's outer object
  *    b = D t0 / L ends: the paper's fixed t then matches seed 002 for
- *    occluders at the casters' typical distance, and smoothies nearer the
- *    light (farther) are too narrow (wide) by z_c / z_s.
+ *    occluders at the casters' typical distance, and a smoothie at depth
+ *    z_s spans D z_s / z_c: too narrow nearer the light, too wide beyond.
  *  - Blending: both buffers keep the darkest fragment per texel (smoothies'
  *    minimum alpha with its depth, as the paper's min-blending; the penumbra
  *    map's maximum I [derived: the paper's choice was not available to
@@ -59,6 +60,10 @@
  *  - The quads extend to both sides of the edge (segment.h's band): the inner
  *    side covers the occluder's own image, where the hard map's umbra
  *    decides, so an edge's orientation in the light's image is not needed.
+ *  - Cost: each edge visits its band's texels, about (length + 2 r) 2 r of
+ *    them; at map_size 1024 on a cube face smoothies' t is about 90 texels
+ *    on sphere-on-plane, and a vertex near the light spreads its cone over
+ *    the whole face (its penumbra does too).
  *
  * Meshes that are not closed 2-manifolds: the silhouette resource extracts
  * their possible silhouette edges by Bergeron's rule (open edges included),
