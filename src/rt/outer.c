@@ -48,6 +48,15 @@ struct OuterScene {
 
 /* ---- the per-object formulas ------------------------------------------- */
 
+/* [OWN] For a rectangle, its mean width over edge directions, perimeter / pi
+ * (Cauchy's formula), since a straight occluder edge's true penumbra is as
+ * wide as the light across it; for a disk this is its diameter. */
+float outer_light_diameter(const Light *l)
+{
+    if (l->kind == LIGHT_RECT) return 2.0f * (l->width + l->height) / 3.14159265358979323846f;
+    return 2.0f * l->radius;
+}
+
 /* Without -ffast-math fminf/fmaxf are library calls; these inline (NaN -> lo). */
 static inline float min_f(float a, float b) { return a < b ? a : b; }
 static inline float clamp01(float x) { return x > 0.0f ? min_f(x, 1.0f) : 0.0f; }
@@ -82,7 +91,7 @@ float outer_sphere_tau(vec3 c_world, float radius, const OuterRay *r)
     if (!(t0 > 0.0f) || !(t0 < r->light_dist)) return INFINITY;
     float d = v3_len(v3_madd(oc, r->dir_world, -t0));
     if (d < radius) return 0.0f;
-    float b = r->light_diameter * (t0 / r->light_dist);
+    float b = r->light_diameter * parker_ratio(t0, r->light_dist);
     return d < radius + b ? (d - radius) / b : INFINITY;
 }
 
@@ -129,7 +138,7 @@ static float triangle_tau_at(const vec3 p[3], vec3 n, float t_plane, const Outer
         float t, d;
         line_segment_approach(r->org_world, r->dir_world, a[k], e[k], &t, &d);
         if (!(t > 0.0f) || !(t < r->light_dist)) continue;
-        float b = r->light_diameter * (t / r->light_dist);
+        float b = r->light_diameter * parker_ratio(t, r->light_dist);
         if (d < b) tau = min_f(tau, d / b);
     }
     return tau;

@@ -34,6 +34,19 @@ typedef struct OuterRay {
     OuterFalloff falloff;
 } OuterRay;
 
+/* Parker's ratio (seed 002 §3, appendix): the outer object of an occluder
+ * t0 from the receiver along a shadow ray of length L = ||l - o|| has size
+ * b = D t0 / L (similar triangles through the light's rim), so b / D = t0 / L.
+ * Every outer-penumbra method scales by it: single_sample_rt's shells, and
+ * smoothies' alpha / (1 - z_s / z_r) (Chan & Durand 2003), which is alpha
+ * over this ratio with t0 = z_r - z_s, L = z_r along the light's axis.
+ * The caller keeps L > 0. */
+static inline float parker_ratio(float t0, float light_dist) { return t0 / light_dist; }
+
+/* D, the light's diameter as seed 002 uses it ("roughly spherical lights"),
+ * world units: 2R for spheres and disks; a rectangle's mean width. */
+float outer_light_diameter(const Light *light);
+
 /* The outer objects of every caster: an analytic sphere for each caster with
  * is_sphere when `analytic_spheres`, else (and for every other caster) one
  * outer triangle per mesh triangle. They do not depend on the light: b is

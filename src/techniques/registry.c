@@ -35,6 +35,8 @@ extern const Technique tech_soft_shadow_volume;
 extern const Technique tech_penumbra_wedge;
 extern const Technique tech_depth_complexity;
 extern const Technique tech_view_sample_mapping;
+extern const Technique tech_smoothies;
+extern const Technique tech_penumbra_map;
 
 static const Technique *const registry[] = {
     &tech_hard,
@@ -66,6 +68,8 @@ static const Technique *const registry[] = {
     &tech_penumbra_wedge,
     &tech_depth_complexity,
     &tech_view_sample_mapping,
+    &tech_smoothies,
+    &tech_penumbra_map,
 };
 
 int tech_count(void) { return (int)(sizeof registry / sizeof registry[0]); }

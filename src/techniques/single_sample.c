@@ -32,17 +32,6 @@ static const ParamDesc ss_params[] = {
 
 static const char *const ss_resources[] = {"embree_bvh", "outer_objects", NULL};
 
-/* D, the light's diameter (seed 002 assumes "roughly spherical lights"): 2R
- * for spheres and disks. [OWN] For a rectangle, its mean width over edge
- * directions, perimeter / pi (Cauchy's formula), since a straight occluder
- * edge's true penumbra is as wide as the light across it; for a disk this is
- * its diameter. */
-static float light_diameter(const Light *l)
-{
-    if (l->kind == LIGHT_RECT) return 2.0f * (l->width + l->height) / 3.14159265358979323846f;
-    return 2.0f * l->radius;
-}
-
 /* ---- the outer objects as a resource -------------------------------------- */
 
 typedef struct OuterArgs {
@@ -97,7 +86,7 @@ typedef struct SingleSampleState {
 
 static bool ss_prepare(const TechContext *ctx, void **state, Error *err)
 {
-    float diameter = light_diameter(ctx->light);
+    float diameter = outer_light_diameter(ctx->light);
     const RtScene *casters = res_bvh(ctx->rm, ctx->scene, RT_CASTERS, err);
     const OuterScene *outer = casters ? res_outer(ctx->rm, ctx->scene, ctx->params[P_ANALYTIC_SPHERES] != 0.0, err) : NULL;
     if (!outer) return false;

@@ -51,8 +51,7 @@ static void soft_light(const Light *light, const MapFace *f, SoftLight *L)
     }
 }
 
-bool softmap_init(SoftMap *sm, ResourceManager *rm, const ShadowMap *map, const Light *light, const char *tech,
-                  Error *err)
+bool softmap_frames(SoftMap *sm, const ShadowMap *map, const Light *light, const char *tech, Error *err)
 {
     const LightView *lv = &map->view;
     bool projective = lv->projection == MAP_PROJ_PERSPECTIVE || lv->projection == MAP_PROJ_CUBE;
@@ -62,8 +61,7 @@ bool softmap_init(SoftMap *sm, ResourceManager *rm, const ShadowMap *map, const 
                               "faces from the light's centre (projection auto, perspective or cube)",
                          tech, map_projection_name(lv->projection));
     sm->map = map;
-    sm->pyramid = res_minmax_pyramid(rm, map, err);
-    if (!sm->pyramid) return false;
+    sm->pyramid = NULL;
     for (int k = 0; k < map->num_faces; k++) {
         const MapFace *f = &lv->face[k];
         SoftFace *sf = &sm->face[k];
@@ -75,6 +73,14 @@ bool softmap_init(SoftMap *sm, ResourceManager *rm, const ShadowMap *map, const 
         soft_light(light, f, &sf->light);
     }
     return true;
+}
+
+bool softmap_init(SoftMap *sm, ResourceManager *rm, const ShadowMap *map, const Light *light, const char *tech,
+                  Error *err)
+{
+    if (!softmap_frames(sm, map, light, tech, err)) return false;
+    sm->pyramid = res_minmax_pyramid(rm, map, err);
+    return sm->pyramid != NULL;
 }
 
 bool softmap_may_block(const SoftMap *sm, const SmapReceiver *r, int i0, int j0, int i1, int j1,

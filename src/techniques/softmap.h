@@ -49,6 +49,9 @@ typedef struct SoftMap {
  * (warps, paraboloids), naming the technique and the projection. */
 bool softmap_init(SoftMap *sm, ResourceManager *rm, const ShadowMap *map, const Light *light, const char *tech,
                   Error *err);
+/* The same without the pyramid (sm->pyramid NULL: softmap_may_block is not
+ * for it), for techniques that read only the faces' frames and depths. */
+bool softmap_frames(SoftMap *sm, const ShadowMap *map, const Light *light, const char *tech, Error *err);
 
 /* Can any texel of [i0, i1] x [j0, j1] block the receiver? false when the
  * pyramid's minimum depth over the window is no closer than the largest
