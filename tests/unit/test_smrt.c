@@ -122,9 +122,9 @@ static long unit_interval(Lab *lab, const char *const *params)
     return cls && bad == 0 ? n : -1;
 }
 
-/* A sphere light just above the ground (receivers around it at the light's
- * own depth, where a ray toward the light runs parallel to the map's
- * faces), and a rect light 30 wide over a small scene (most of the light
+/* A sphere light just above the ground (receivers below it at the light's
+ * own depth in the cube's bottom face, where a ray toward a light point
+ * runs parallel to the face), and a rect light 30 wide over a small scene (most of the light
  * lies outside the map's field of view, so its rays leave the map). */
 static const char *const low_light_scene =
     "return {\n"
@@ -133,6 +133,19 @@ static const char *const low_light_scene =
     "  objects = {\n"
     "    { name = 'ground', shape = 'plane', size = {6, 6} },\n"
     "    { name = 'box', shape = 'box', size = {0.3, 0.3, 0.3}, translate = {0.6, 0.15, 0} },\n"
+    "  },\n"
+    "}\n";
+/* A 1 x 1 rect light standing on the ground, facing +x: the ground beside
+ * it lies in the light's own plane (depth 0 in its map), the ground in
+ * front of it at every depth from there on. */
+static const char *const standing_light_scene =
+    "return {\n"
+    "  camera = { position = {2, 3, 3}, target = {1, 0, 0}, fov = 50, width = 64, height = 48 },\n"
+    "  lights = { { type = 'rect', position = {0, 0.5, 0}, direction = {1, 0, 0}, up = {0, 1, 0},\n"
+    "               width = 1, height = 1 } },\n"
+    "  objects = {\n"
+    "    { name = 'ground', shape = 'plane', size = {6, 6} },\n"
+    "    { name = 'box', shape = 'box', size = {0.3, 0.3, 0.3}, translate = {1, 0.15, 0} },\n"
     "  },\n"
     "}\n";
 static const char *const wide_light_scene =
@@ -151,14 +164,17 @@ TEST(test_smrt_bad_input_stays_finite_in_the_unit_interval)
     const char *minimal[] = {"rays=1", "steps=1", NULL};
     Lab *ball = soft_open("sphere-on-plane.lua", (const char *[]){"camera.width=64", "camera.height=48", NULL});
     Lab *low = fixture_lab("low-light.lua", low_light_scene), *wide = fixture_lab("wide-light.lua", wide_light_scene);
-    CHECK(ball && low && wide);
+    Lab *standing = fixture_lab("standing-light.lua", standing_light_scene);
+    CHECK(ball && low && wide && standing);
     long a = unit_interval(ball, minimal), b = unit_interval(low, NULL), c = unit_interval(low, minimal);
     long d = unit_interval(wide, NULL), e = unit_interval(wide, minimal);
-    printf("    lit candidates in [0, 1]: rays=1 steps=1 %ld; light at the receivers' depth %ld, %ld; light wider than "
-           "the map %ld, %ld (-1: a value outside)\n",
-           a, b, c, d, e);
-    CHECK(a > 0 && b > 0 && c > 0 && d > 0 && e > 0);
+    long f = unit_interval(standing, NULL), g = unit_interval(standing, minimal);
+    printf("    lit candidates in [0, 1]: rays=1 steps=1 %ld; light at the receivers' depth %ld, %ld (standing rect: "
+           "%ld, %ld); light wider than the map %ld, %ld (-1: a value outside)\n",
+           a, b, c, f, g, d, e);
+    CHECK(a > 0 && b > 0 && c > 0 && d > 0 && e > 0 && f > 0 && g > 0);
     lab_close(ball);
     lab_close(low);
     lab_close(wide);
+    lab_close(standing);
 }
