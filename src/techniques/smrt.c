@@ -8,9 +8,17 @@
  *     (nothing is stored before it), and `spread` of that part is marched:
  *     t in (0, t_max], t_max = spread (z_p - n) / (z_p - z_L) in depths along
  *     the receiver's face (t = 1: the light point);
- *  2. `steps` samples t_k = t_max (N - k - xi) / N, k = 0 .. N - 1, jittered
- *     per ray by xi in [0, 1) (UE5's per-pixel step dither), are visited from
- *     the light end toward the receiver; each is located in the map (its own
+ *  2. `steps` samples t_k = t_max u_k^2, u_k = (N - k - xi) / N, k = 0 ..
+ *     N - 1, jittered per ray by xi in [0, 1) (UE5's per-pixel step dither),
+ *     are visited from the light end toward the receiver. [OWN] the square
+ *     packs them toward the receiver: the stretch of a ray that lies in
+ *     front of a caster's visible face yet inside its silhouette shrinks
+ *     with the caster's distance from the receiver (similar triangles), so
+ *     contacts need the finest steps; measured against uniform t_k (7 x 8,
+ *     160 x 120, 64 samples), umbra leak contact 0.056 -> 0.034, bunny 0.063
+ *     -> 0.017, ball-and-disk 0.061 -> 0.008, overlap 0.0125 -> 0.0112,
+ *     sphere-on-plane 0.0047 -> 0.0064 (penumbra RMSE within 0.01 but for
+ *     overlap, 0.090 -> 0.101). Each sample is located in the map (its own
  *     face), with ray depth z_k and stored depth d_k (linear, world units
  *     along that face's axis; +INFINITY where nothing was drawn or the
  *     sample is off the map);
@@ -186,7 +194,7 @@ static double ray_visibility(const SmrtState *st, dvec3 p, dvec3 l, double t_max
     History h = {.valid = false};
     int n = st->steps;
     for (int k = 0; k < n; k++) {
-        double t = t_max * (n - k - xi) / n;
+        double u = (n - k - xi) / n, t = t_max * u * u;
         MarchSample ms = march_sample(st->map, d3_madd(p, d3_sub(l, p), t));
         if (isnan(ms.d) || isnan(ms.z)) return NAN;
         if (ms.z <= ms.d + tol) { /* in front of the stored surface */
