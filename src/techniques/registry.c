@@ -30,6 +30,7 @@ extern const Technique tech_aliasing;
 extern const Technique tech_backprojection;
 extern const Technique tech_light_sampling;
 extern const Technique tech_occlusion_textures;
+extern const Technique tech_smrt;
 extern const Technique tech_shadow_volume;
 extern const Technique tech_soft_shadow_volume;
 extern const Technique tech_penumbra_wedge;
@@ -63,6 +64,7 @@ static const Technique *const registry[] = {
     &tech_backprojection,
     &tech_light_sampling,
     &tech_occlusion_textures,
+    &tech_smrt,
     &tech_shadow_volume,
     &tech_soft_shadow_volume,
     &tech_penumbra_wedge,

@@ -155,6 +155,7 @@ bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_g
         r->mc = lightview_locate(lv, p);
         r->texel_world = lightview_texel_world(lv, &r->mc);
     }
+    r->p_world = p;
     r->plane = false;
     if (!r->mc.inside) return false;
     double ndc_per_world = lightview_ndc_per_world(lv, &r->mc);

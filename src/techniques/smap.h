@@ -172,6 +172,7 @@ SmapBias smap_depth_bias(const double *params, const Scene *scene);
 /* A view sample as the map sees it. */
 typedef struct SmapReceiver {
     MapCoord mc;            /* of the (normal-offset) lookup point */
+    dvec3 p_world;          /* that lookup point, world units (rays marched through the map start here) */
     double texel_world;     /* texel width at the receiver, world units */
     double ref;             /* the biased reference depth, in the map's stored metric */
     double bias;            /* the bias subtracted, stored metric */

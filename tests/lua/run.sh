@@ -228,6 +228,8 @@ TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeat 1 --warm
 expect error_vs_time_runs 0 "report:" -- "$SL" run experiments/error-vs-time.lua --factors 1 $TINY --out "$TMP/evt"
 expect error_vs_time_plot_shows_every_registered_technique 0 "every registered technique" -- \
     "$SL" run tests/lua/every-technique.lua "$TMP/evt"
+expect smrt_rays_steps_runs 0 "42 computed" "0 failed" "report:" -- \
+    "$SL" run experiments/smrt-rays-steps.lua $TINY --out "$TMP/smrt"
 # the labs with images (their questions cite the signed-error images), then every question's citations
 LAB_TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeat 1 --warmup 0"
 expect lab_kernel_size_runs 0 "0 failed" "report:" -- \
