@@ -22,6 +22,7 @@ extern const Technique tech_pcss;
 extern const Technique tech_pcss_prefiltered;
 extern const Technique tech_cssm;
 extern const Technique tech_evssm;
+extern const Technique tech_essm;
 extern const Technique tech_dpcf;
 extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
@@ -52,6 +53,7 @@ static const Technique *const registry[] = {
     &tech_pcss_prefiltered,
     &tech_cssm,
     &tech_evssm,
+    &tech_essm,
     &tech_dpcf,
     &tech_adaptive_area,
     &tech_shadow_width,
