@@ -23,6 +23,7 @@ extern const Technique tech_pcss_prefiltered;
 extern const Technique tech_cssm;
 extern const Technique tech_evssm;
 extern const Technique tech_essm;
+extern const Technique tech_moment_soft;
 extern const Technique tech_dpcf;
 extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
@@ -54,6 +55,7 @@ static const Technique *const registry[] = {
     &tech_cssm,
     &tech_evssm,
     &tech_essm,
+    &tech_moment_soft,
     &tech_dpcf,
     &tech_adaptive_area,
     &tech_shadow_width,

@@ -1,32 +1,67 @@
-/* test_essm_moment_soft.c -- `essm` (Shen et al. 2013), the exponential
- * constant-time soft shadows (filtsoft.h):
- *   - where the paper claims accuracy, one planar occluder parallel to the
+/* test_essm_moment_soft.c -- `essm` (Shen et al. 2013) and `moment_soft`
+ * (Peters et al. 2016), the exponential and four-moment constant-time soft
+ * shadows (filtsoft.h):
+ *   - the Hamburger blocker search (msm_blockers) on a two-point window
+ *     returns the blocked fraction and the blockers' depth; NaN is carried;
+ *   - where the papers claim accuracy, one planar occluder parallel to the
  *     receiver (test_pcss.c's strip) under a square rect light and a sphere
  *     light: penumbra RMSE against Embree within a stated bound;
- *   - its failure, occluder fusion on overlap.lua (course Figs. 1.7, 5.19):
+ *   - their failure, occluder fusion on overlap.lua (course Figs. 1.7, 5.19):
  *     the signed error measured, the strip's bound broken on a share of the
  *     penumbra;
- *   - plane_normalise on contact.lua's tilted floor.
+ *   - essm's plane_normalise on contact.lua's tilted floor.
  * 128 x 96 (strip) and 160 x 120 (overlap, contact) views, 256^2 to 1024^2
- * maps, 256-sample references (64 on contact); about 5 s in all at -O2. */
+ * maps, 256-sample references (64 on contact); about 7 s in all at -O2. */
 #include <math.h>
 #include "fixtures.h"
 #include "signed_error.h"
 #include "soft_helpers.h"
+#include "techniques/filtered.h"
 #include "test.h"
 
 #define REF_SAMPLES 256
 #define STRIP_HEIGHT 2.0
 
-static const char *const techs[] = {"essm"};
-#define NUM_TECHS 1
+static const char *const techs[] = {"essm", "moment_soft"};
+#define NUM_TECHS 2
+
+/* A window of two depths: weight f at z_o (the occluder), 1 - f at z_r. */
+static void two_point(double f, double z_o, double z_r, double *b)
+{
+    double po = z_o, pr = z_r;
+    for (int k = 0; k < 4; k++, po *= z_o, pr *= z_r) b[k] = f * po + (1.0 - f) * pr;
+}
+
+TEST(test_essm_moment_soft_hamburger_blocker_search_on_two_depths)
+{
+    static const double cases[][3] = {{0.3, -0.6, 0.8}, {0.75, 0.1, 0.9}, {0.05, -1.0, 1.0}};
+    double worst_f = 0.0, worst_z = 0.0;
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        double b[4], blocked, z_mean, f = cases[k][0], z_o = cases[k][1], z_r = cases[k][2];
+        two_point(f, z_o, z_r, b);
+        /* the receiver's reference just in front of its own depth (the bias), as smap_receiver's */
+        CHECK(msm_blockers(b, z_r - 1e-3, 3e-5, &blocked, &z_mean));
+        worst_f = fmax(worst_f, fabs(blocked - f));
+        worst_z = fmax(worst_z, fabs(z_mean - z_o));
+        CHECK_MSG(fabs(msm_lit(b, z_r - 1e-3, 3e-5) - (1.0 - blocked)) < 1e-9, "msm_lit and msm_blockers disagree");
+    }
+    printf("    two depths: |G - f| <= %.2g, |z_avg - z_o| <= %.2g (moment bias 3e-5)\n", worst_f, worst_z);
+    CHECK_MSG(worst_f < 2e-3 && worst_z < 2e-3, "blocked %.3g, depth %.3g off", worst_f, worst_z);
+    double b[4], blocked, z_mean;
+    two_point(0.3, -0.6, 0.8, b);
+    CHECK(msm_blockers(b, -0.9, 3e-5, &blocked, &z_mean) && fabs(blocked) < 1e-9); /* nothing in front: G = 0 */
+    b[2] = NAN;
+    CHECK(msm_blockers(b, 0.5, 3e-5, &blocked, &z_mean) && isnan(blocked) && isnan(z_mean));
+    CHECK(isnan(msm_lit(b, 0.5, 3e-5)));
+}
 
 /* The strip under a 1 x 1 rect light and a sphere light of radius 0.5, both
  * 4 above the ground, the strip 2 above it: the papers' setting (one planar
- * occluder parallel to the receiver), where it is PCSS with a box filter
+ * occluder parallel to the receiver), where each is PCSS with a box filter
  * up to its reconstruction's error. Bounds: penumbra RMSE against Embree
  * within PCSS_SLACK of exhaustive pcss's own on the same map (measured
- * differences: rect +0.0006, sphere +0.0002), and under the rect light the box's bound 0.5 / W + 0.004 +
+ * differences: rect essm +0.0006, moment_soft 0.0000; sphere +0.0002,
+ * -0.0001), and under the rect light the box's bound 0.5 / W + 0.004 +
  * 2 noise of test_filtered_soft.c (W = 15.75, its window in texels). */
 #define PCSS_SLACK 0.005
 static const char *const strip_lights[] = {
@@ -73,10 +108,11 @@ TEST(test_essm_moment_soft_on_parallel_planes)
  * average depth stands for two occluders in one window, and the map holds
  * only the high one where they overlap. The signed error per region is
  * measured and the strip's bound (at its window, 15.75 texels) broken on
- * more than 1/50 of the penumbra; it errs toward light (one blocker depth
+ * more than 1/50 of the penumbra; both err toward light (one blocker depth
  * for two, the lower slab's penumbra too narrow). Measured at 160 x 120,
  * 512^2: essm penumbra RMSE 0.221, signed +0.058 (659 samples too lit, 223
- * too dark of 2057), umbra +0.101. */
+ * too dark of 2057), umbra +0.101; moment_soft 0.060, +0.009 (256, 75),
+ * umbra +0.044. */
 #define FUSION_BOUND (0.5 / 15.75 + 0.004)
 TEST(test_essm_moment_soft_overlap_fusion)
 {
