@@ -19,6 +19,12 @@
  *      theory" for the blocker estimate, its formulas are not checked here];
  *   2. the filter window from z_avg (course §5.2.2 step 2);
  *   3. ESM over it: min(1, E e(z) / e(d)).
+ * plane_normalise [OWN] divides both windows' E e(z) by the receiver plane's
+ * own box mean of e(u) over that window in place of e(d) (log_receiver_mean):
+ * a floor tilted to the light puts texels deeper than d in the window, whose
+ * terms e^(c (z - d)) > 1 (course §4.2.4's failure, "invalidating the
+ * summation") read lit where the umbra is (contact.lua: umbra leak 0.658 ->
+ * 0.355, test_essm_moment_soft.c).
  * For one planar occluder parallel to the receiver the search window holds
  * the occluder's depth and the receiver's: q = 1 - f + f e^(-c gap) and
  * z_avg the occluder's depth up to e^(-c gap) terms, so the result is the

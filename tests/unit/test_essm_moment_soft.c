@@ -50,6 +50,9 @@ TEST(test_essm_moment_soft_hamburger_blocker_search_on_two_depths)
     double b[4], blocked, z_mean;
     two_point(0.3, -0.6, 0.8, b);
     CHECK(msm_blockers(b, -0.9, 3e-5, &blocked, &z_mean) && fabs(blocked) < 1e-9); /* nothing in front: G = 0 */
+    /* one depth, the receiver's own, unbiased: the quadratic is degenerate, the caller falls back on two moments */
+    double one[4] = {0.5, 0.25, 0.125, 0.0625};
+    CHECK(!msm_blockers(one, 0.5, 0.0, &blocked, &z_mean) && msm_lit(one, 0.5, 0.0) == 1.0);
     b[2] = NAN;
     CHECK(msm_blockers(b, 0.5, 3e-5, &blocked, &z_mean) && isnan(blocked) && isnan(z_mean));
     CHECK(isnan(msm_lit(b, 0.5, 3e-5)));
