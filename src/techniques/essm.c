@@ -24,7 +24,7 @@
  * a floor tilted to the light puts texels deeper than d in the window, whose
  * terms e^(c (z - d)) > 1 (course §4.2.4's failure, "invalidating the
  * summation") read lit where the umbra is (contact.lua: umbra leak 0.658 ->
- * 0.355, test_essm_moment_soft.c).
+ * 0.391, test_essm_moment_soft.c).
  * For one planar occluder parallel to the receiver the search window holds
  * the occluder's depth and the receiver's: q = 1 - f + f e^(-c gap) and
  * z_avg the occluder's depth up to e^(-c gap) terms, so the result is the
@@ -110,23 +110,27 @@ static double plane_unit(const EssmState *st, const SmapReceiver *r, double ds, 
     return prefilter_depth_unit(st->fs.sm.map, r->mc.face, r->reciprocal ? 1.0 / g : g);
 }
 
-/* ln of what a window of the receiver's own texels holds, the ESM quotient's
- * denominator: plain ESM (course Eq. 4.7, erratum), c (d - 1) for the
- * stored e^(c (z - 1)); with plane_normalise [OWN], the box mean of e^(c (u - 1))
- * over the window of the receiver's plane u = u0 + a x + b y (x, y in
- * texels, a, b its slopes there): c (u0 - 1) + ln sinhc(c a hx) + ln sinhc(c b hy),
- * so a window holding only the receiver reads exactly 1. */
-static double log_receiver_mean(const EssmState *st, const SmapReceiver *r, double u, FsWindow w)
+/* ln of the window mean of e^(k c (u' - o)) over the receiver's own texels
+ * u' (k = 1, o = 1: the stored positive warp; k = -1, o = 0: the negative).
+ * Plain ESM (course Eq. 4.7, erratum) takes them all at the reference d:
+ * k c (d - o). With plane_normalise [OWN], u' = d + a x + b y on the
+ * receiver's plane (x, y in texels, a, b its slopes there), whose box mean
+ * over the half-widths (hx, hy) factors: k c (d - o) + ln sinhc(c a hx) +
+ * ln sinhc(c b hy) (sinhc even, so for both signs); so a window holding only
+ * the receiver reads 1, and a receiver facing the light (a = b = 0) is
+ * plain ESM. */
+static double log_receiver_mean(const EssmState *st, const SmapReceiver *r, double u, FsWindow w, double k, double o)
 {
-    if (!st->plane || !r->plane) return st->c * (u - 1.0);
+    double plain = k * st->c * (u - o);
+    if (!st->plane || !r->plane) return plain;
     double u0 = plane_unit(st, r, 0.0, 0.0), a = plane_unit(st, r, 1.0, 0.0) - u0, b = plane_unit(st, r, 0.0, 1.0) - u0;
-    return st->c * (u0 - 1.0) + log_sinhc(st->c * a * w.hx) + log_sinhc(st->c * b * w.hy);
+    return plain + log_sinhc(st->c * a * w.hx) + log_sinhc(st->c * b * w.hy);
 }
 
 /* The ESM lit fraction over window w from its mean m0 of e^(c (z - 1)); unclamped, NaN kept. */
 static double esm_lit(const EssmState *st, const SmapReceiver *r, double m0, double u, FsWindow w)
 {
-    return m0 / exp(log_receiver_mean(st, r, u, w));
+    return m0 / exp(log_receiver_mean(st, r, u, w, 1.0, 1.0));
 }
 
 /* Step 1: the blockers' exponential mean depth (normalised); false: lit. */
@@ -134,8 +138,9 @@ static bool essm_blocker(const EssmState *st, const SmapReceiver *r, const doubl
                          double *z_avg)
 {
     double q = nan_min(1.0, esm_lit(st, r, m[0], u, w)), e_occ;
-    if (!filtsoft_blocker_mean(-m[2], q, exp(-st->c * u), st->lit_eps, &e_occ)) return false;
-    /* e_occ <= e^(-c u) is rounding below the receiver's own term: blockers at the receiver (a NaN passes on) */
+    double lit_term = exp(log_receiver_mean(st, r, u, w, -1.0, 0.0)); /* the lit texels' mean of e^(-c z) */
+    if (!filtsoft_blocker_mean(-m[2], q, lit_term, st->lit_eps, &e_occ)) return false;
+    /* e_occ <= 0 is rounding (E e^(-c z) below the lit texels' share): blockers at the receiver (a NaN passes on) */
     double z = e_occ > 0.0 ? -log(e_occ) / st->c : e_occ <= 0.0 ? u : e_occ;
     *z_avg = nan_clamp(z, 0.0, u);
     return true;

@@ -152,7 +152,7 @@ TEST(test_essm_moment_soft_overlap_fusion)
  * floor's texels deeper than the receiver give ESM terms above 1 (course
  * §4.2.4's failure), which lit the umbra; divided by the plane's own window
  * mean they read 1 where nothing blocks. Measured umbra leak 0.658 (off) ->
- * 0.355 (on), lit samples' signed error -0.002 both; what remains is ESM's
+ * 0.391 (on), lit samples' signed error -0.002 -> -0.001; what remains is ESM's
  * contact term e^(-c gap) (defaults-matrix.lua's EXPECTED). About 1 s. */
 TEST(test_essm_moment_soft_essm_plane_normalise_on_tilted_receivers)
 {
