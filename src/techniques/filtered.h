@@ -87,4 +87,25 @@ double evsm_negative_bound(const double *m, double u, double c_neg, double min_v
  * smoothstep-remapped onto [0, 1]; amount 0 leaves p unchanged. */
 double bleed_reduce(double p, double amount);
 
+/* ---- Hamburger four-moment reconstruction (msm, moment_soft) ----
+ * Peters & Klein 2015, Algorithm 2 (Hamburger 4MSM), with the authors'
+ * erratum. b: a window's moments of the signed depth z = 2u - 1; zf: the
+ * receiver's z; alpha: the moment bias b' = (1 - alpha) b + alpha (0, 0.63,
+ * 0, 0.63). Solving B c = (1, zf, zf^2) for the Hankel matrix B of b' gives
+ * the roots z2 <= z3 of c1 + c2 x + c3 x^2; the three-point distribution on
+ * {zf, z2, z3} with moments b' is the one that bounds the shadow below. */
+
+/* The lit fraction 1 - G, G the weight of that distribution in front of zf
+ * (the sharpest lower bound on the shadow); NaN for a NaN moment or zf. */
+double msm_lit(const double *b, double zf, double alpha);
+/* The blocker search of Peters et al. 2016 (I3D, §5, moment soft shadow
+ * mapping; the authors' shader, Compute4MomentAverageBlockerDepth): the
+ * same distribution's weight in front of zf, *blocked = G = sum of w_i over
+ * the roots z_i < zf, and the mean depth of that weight, *z_mean =
+ * sum w_i z_i / G (signed depth). false when the quadratic is degenerate
+ * (no finite weights: the caller falls back on two moments, as msm_lit
+ * does); a NaN moment or zf gives NaN results (true). *z_mean is NaN for
+ * G = 0. */
+bool msm_blockers(const double *b, double zf, double alpha, double *blocked, double *z_mean);
+
 #endif

@@ -23,6 +23,8 @@ extern const Technique tech_pcss_prefiltered;
 extern const Technique tech_cssm;
 extern const Technique tech_evssm;
 extern const Technique tech_vssm;
+extern const Technique tech_essm;
+extern const Technique tech_moment_soft;
 extern const Technique tech_dpcf;
 extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
@@ -57,6 +59,8 @@ static const Technique *const registry[] = {
     &tech_cssm,
     &tech_evssm,
     &tech_vssm,
+    &tech_essm,
+    &tech_moment_soft,
     &tech_dpcf,
     &tech_adaptive_area,
     &tech_shadow_width,

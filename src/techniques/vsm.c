@@ -155,41 +155,6 @@ static double evsm_lit(const MomentState *st, const double *m, double u)
     return st->negative ? nan_min(p, evsm_negative_bound(m, u, st->c_neg, st->min_variance)) : p;
 }
 
-#define MSM_PIVOT_MIN 1e-12
-
-/* Peters & Klein 2015, Algorithm 2 (Hamburger 4MSM), with the authors'
- * erratum. b: the window's moments of z = 2u - 1; zf: the receiver's z.
- * Solve B c = (1, zf, zf^2) by Cholesky for the Hankel matrix B of the
- * biased moments, take the roots z2 <= z3 of c1 + c2 x + c3 x^2, and the
- * sharpest lower bound G of the shadow from the three-point distribution
- * on {zf, z2, z3}. Returns the lit fraction 1 - G. */
-static double msm_lit(const double *b_in, double zf, double alpha)
-{
-    static const double b_bias[4] = {0.0, 0.63, 0.0, 0.63};
-    /* A NaN moment would vanish in the pivots' clamps below (fmax(NaN, eps) = eps). */
-    if (isnan(b_in[0] + b_in[1] + b_in[2] + b_in[3] + zf)) return NAN;
-    double b[4];
-    for (int k = 0; k < 4; k++) b[k] = (1.0 - alpha) * b_in[k] + alpha * b_bias[k];
-    double l21 = b[0], l31 = b[1];
-    double l22 = sqrt(fmax(b[1] - l21 * l21, MSM_PIVOT_MIN));
-    double l32 = (b[2] - l21 * l31) / l22;
-    double l33 = sqrt(fmax(b[3] - l31 * l31 - l32 * l32, MSM_PIVOT_MIN));
-    double y2 = (zf - l21) / l22, y3 = (zf * zf - l31 - l32 * y2) / l33;
-    double c3 = y3 / l33, c2 = (y2 - l32 * c3) / l22, c1 = 1.0 - l21 * c2 - l31 * c3;
-    /* Roots without cancellation: q = -(c2 + sign(c2) sqrt(disc)) / 2, x = q / c3 and c1 / q. */
-    double r = sqrt(fmax(c2 * c2 - 4.0 * c1 * c3, 0.0)), q = -0.5 * (c2 + copysign(r, c2));
-    double z2 = q / c3, z3 = c1 / q;
-    if (z2 > z3) { double t = z2; z2 = z3; z3 = t; }
-    double G;
-    if (zf <= z2) G = 0.0;
-    else if (zf <= z3) G = (zf * z3 - b[0] * (zf + z3) + b[1]) / ((z3 - z2) * (zf - z2));
-    else G = 1.0 - (z2 * z3 - b[0] * (z2 + z3) + b[1]) / ((zf - z2) * (zf - z3));
-    /* A degenerate quadratic (c3 or q = 0) leaves no usable roots: fall
-     * back on Chebyshev's bound from the same (biased) first two moments. */
-    if (!isfinite(G)) return chebyshev_upper(b[0], b[1], zf, 0.0);
-    return 1.0 - (G < 0.0 ? 0.0 : G > 1.0 ? 1.0 : G);
-}
-
 static double moment_lit(const MomentState *st, const FilteredSample *fs)
 {
     switch (st->method) {
