@@ -30,7 +30,24 @@
  * [OWN]: the course gives none, and Annen et al. 2008 was not available to
  * check what the paper uses (their mip-mapped basis images are replaced
  * here by a SAT). Measured at 160 x 120 (strip 128 x 96), 1024^2 (strip
- * 256^2, overlap 512^2), M = 8. */
+ * 256^2, overlap 512^2), M = 8.
+ * The umbra floor (issue 16, scenes/parallel-planes.lua), the basis' limit,
+ * not a defect: a window of blockers at one depth u_o filters to the basis
+ * at u_o, so the visibility is the series itself at the gap,
+ *   V_umbra = s step_M,a((u_o - (u_r - o)) / 2),
+ * the damped Gibbs residual (course §4.2.3: damping gives "no guarantee"),
+ * never exactly 0, doubled by s = 2 (Annen et al. 2007's scaling, as their
+ * public shader's clamp(2 rec, 0, 1)). M = 8, a = 1: -0.009..+0.046 over
+ * gaps 0.2..1 in u; damping raises it (a = 2: +0.014..+0.054, the damped
+ * weights no longer sum to the step's). Parallel planes, u_o 0.010, u_r
+ * 0.981: predicted 0.01823, measured 0.01822 in every deep-umbra sample,
+ * above soft-failures.lua's umbra threshold 0.01: its "umbra x0.00" and
+ * "penumbra x8.9 (r = 0.03)" count the floor as penumbra. The ramp above
+ * the floor is 1.15 / 0.77 / 0.73 x the closed form at r = 0.03 / 0.1 /
+ * 0.3 (reference 0.74 / 0.90 / 0.97): blocker_offset 0.1 is inside the
+ * step's transition, the receiver's own texels count about 6% blockers and
+ * pull z_avg toward d, narrowing the window (0.15: 1.07 / 0.97 x the
+ * reference at r = 0.1 / 0.3). Tested in test_filtered_soft.c. */
 #include <stdlib.h>
 #include "techniques/filtsoft.h"
 
