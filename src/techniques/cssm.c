@@ -30,11 +30,37 @@
  * [OWN]: the course gives none, and Annen et al. 2008 was not available to
  * check what the paper uses (their mip-mapped basis images are replaced
  * here by a SAT). Measured at 160 x 120 (strip 128 x 96), 1024^2 (strip
- * 256^2, overlap 512^2), M = 8. */
+ * 256^2, overlap 512^2), M = 8.
+ * The umbra floor (issue 16, scenes/parallel-planes.lua), the basis' limit,
+ * not a defect: a window of blockers at one depth u_o filters to the basis
+ * at u_o, so the visibility is the series itself at the gap,
+ *   V_umbra = s step_M,a((u_o - (u_r - o)) / 2),
+ * the damped Gibbs residual (course §4.2.3: damping gives "no guarantee"),
+ * never exactly 0, doubled by s = 2 (Annen et al. 2007's scaling, as their
+ * public shader's clamp(2 rec, 0, 1)). M = 8, a = 1: -0.009..+0.046 over
+ * gaps 0.2..1 in u; damping raises it (a = 2: +0.014..+0.054, the damped
+ * weights no longer sum to the step's). Parallel planes, u_o 0.010, u_r
+ * 0.981: predicted 0.01823, measured 0.01822 in every deep-umbra sample,
+ * above soft-failures.lua's umbra threshold 0.01: its "umbra x0.00" and
+ * "penumbra x8.9 (r = 0.03)" count the floor as penumbra. The ramp above
+ * the floor is 1.15 / 0.77 / 0.73 x the closed form at r = 0.03 / 0.1 /
+ * 0.3 (reference 0.74 / 0.90 / 0.97): blocker_offset 0.1 is inside the
+ * step's transition, the receiver's own texels count about 6% blockers and
+ * pull z_avg toward d, narrowing the window (0.15: 1.07 / 0.97 x the
+ * reference at r = 0.1 / 0.3). `floor` (off by default: the paper's
+ * reconstruction) removes the floor at the blocker average (cssm_filter,
+ * [OWN]): there the deep umbra is 0 and the umbra's area the reference's
+ * (x1.000 at r = 0.1). Tested in test_filtered_soft.c. */
 #include <stdlib.h>
 #include "techniques/filtsoft.h"
 
-enum { P_MAX_RADIUS = SMAP_NUM_DEPTH_BIAS_PARAMS, P_PRECISION, P_TERMS, P_DAMPING, P_OFFSET, P_SCALE, P_BLOCKER_OFFSET, P_LIT_THRESHOLD };
+enum {
+    P_MAX_RADIUS = SMAP_NUM_DEPTH_BIAS_PARAMS, P_PRECISION, P_TERMS, P_DAMPING, P_OFFSET, P_SCALE, P_BLOCKER_OFFSET,
+    P_LIT_THRESHOLD, P_FLOOR
+};
+
+/* The largest umbra floor removed (floor = 1: [OWN], below). */
+#define CSSM_FLOOR_MAX 0.5
 
 static const ParamDesc cssm_params[] = {
     /* perspective faces (softmap.h), one cascade: a prefiltered table per face (with cascades, split_scheme
@@ -61,6 +87,11 @@ static const ParamDesc cssm_params[] = {
      NULL},
     {"lit_threshold", PARAM_FLOAT, 0.02, 1e-6, 0.5, "fraction",
      "1 - pcf over the search window below this is lit (course §5.2.2.3: the denominator nears 0)", NULL},
+    {"floor", PARAM_BOOL, 0, 0, 1, "",
+     "remove the umbra floor: V' = (V - F) / (1 - F), F the filter's value for a window all at the blocker average "
+     "(the series' residual, never 0; [OWN], exact for one blocker depth over the receiver; F at most 0.5); "
+     "0: Annen et al.'s clamp(s x step, 0, 1)",
+     NULL},
 };
 FILTER_CHECK_TABLE(cssm_params);
 
@@ -71,6 +102,7 @@ typedef struct CssmState {
     const Prefiltered *sat;     /* sin(c_k v), cos(c_k v); u; u sin(c_k v), u cos(c_k v): 4M + 1 channels, v = u/2 */
     int terms;
     double offset, scale, blocker_offset, lit_threshold;
+    bool remove_floor;
     double coef[FILTSOFT_MAX_TERMS];
 } CssmState;
 
@@ -84,6 +116,7 @@ static bool cssm_prepare(const TechContext *ctx, void **state, Error *err)
     st->offset = p[P_OFFSET];
     st->blocker_offset = p[P_BLOCKER_OFFSET];
     st->lit_threshold = p[P_LIT_THRESHOLD];
+    st->remove_floor = p[P_FLOOR] != 0.0;
     filtsoft_fourier_coefficients(st->terms, p[P_DAMPING], st->coef);
     bool f64 = (int)p[P_PRECISION] == 0;
     MomentSpec spec = {.warp = WARP_FOURIER_DEPTH, .order = st->terms, .f64 = f64};
@@ -120,6 +153,26 @@ static bool cssm_blocker(const CssmState *st, const SmapReceiver *r, FsWindow w,
     return true;
 }
 
+/* The filter's lit fraction s x step, and with `floor` its umbra floor F
+ * removed ([OWN]): a window all at the blocker average z_avg (normalised)
+ * filters to the basis at z_avg, so F = s step(z_avg - d) is what blockers
+ * at that depth return (the damped Gibbs residual at the gap, -0.009..+0.046
+ * for M = 8); in a window of blockers at z_avg and receiver texels (s x 1/2
+ * = 1 at s = 2) the lit fraction is V = F f + (1 - f) for a blocked fraction f, so
+ * (V - F) / (1 - F) = 1 - f exactly. F is capped at CSSM_FLOOR_MAX, where
+ * blockers within the step's transition of d (contact, 2/M of the depth
+ * range) would divide by 1 - F -> 0; a NaN F stays NaN. */
+static double cssm_filter(const CssmState *st, const double *m, double z_avg, double u)
+{
+    double v = st->scale * step_at(st, m, u - st->offset);
+    if (!st->remove_floor) return v;
+    double b[PREFILTER_MAX_CHANNELS];
+    fourier_basis(0.5 * z_avg, st->terms, b); /* half depths, as the SAT's channels */
+    double f = st->scale * step_at(st, b, u - st->offset);
+    f = f > CSSM_FLOOR_MAX ? CSSM_FLOOR_MAX : f;
+    return (v - f) / (1.0 - f);
+}
+
 static double cssm_visibility(const CssmState *st, const SmapReceiver *r)
 {
     FsWindow ws;
@@ -130,7 +183,7 @@ static double cssm_visibility(const CssmState *st, const SmapReceiver *r)
     FsWindow wf = filtsoft_filter_window(&st->fs, r, filtsoft_linear(&st->fs, r->mc.face, z_avg), z_min);
     if (!pf_fetch_box(st->sat, r->mc.face, r->mc.s, r->mc.t, wf.hx, wf.hy, 2 * st->terms, m)) /* the basis only */
         return NAN;
-    return st->scale * step_at(st, m, u - st->offset);
+    return cssm_filter(st, m, z_avg, u);
 }
 
 static void cssm_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
