@@ -70,48 +70,45 @@ enum { CLASS_LIT, CLASS_UMBRA, CLASS_BACKPROJECTED }; /* aux `class` */
 #define BP_MAX_HSM_LEVELS 15 /* a 16384^2 map's pyramid */
 
 /* Plain perspective faces only (softmap.h): no warps or frustum-face splits. */
-#define BP_PARAMS                                                                                                   \
-    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_CUBE, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT), SMAP_BIAS_PARAMS_PLANE(1),          \
-        {"occluder", PARAM_ENUM, OCC_MICROQUAD, 0, 2, "",                                                            \
-         "occluder representation (course §5.2.3.3): micropatch (each lexel's square at its depth: over-occludes, " \
-         "keeps one-texel twigs), microquad (quads of 2 x 2 lexel centres, all four in front: no gaps, misses "      \
-         "one-texel twigs; the course's recommendation with bitmasks) or microtri (also triangles of three of four)", \
-         occluder_names},                                                                                            \
-        {"gaps", PARAM_ENUM, GAPS_DIAGONAL, 0, 2, "",                                                                \
-         "occluder=micropatch: gap filling (course §5.2.3.3): none (neighbouring patches at different depths leave " \
-         "slits that leak light), guennebaud (each patch extended to its left and bottom neighbours', Guennebaud "   \
-         "2006) or diagonal (also its bottom-left corner to the diagonal neighbour's, Bavoil 2008)",                 \
-         gaps_names},                                                                                                \
-        {"accumulate", PARAM_ENUM, ACC_BITMASK, 0, 1, "",                                                            \
-         "bitmask (Schwarz & Stamminger 2007: one bit per light sample, the union of the occluders' masks, V = 1 - " \
-         "popcount / N) or area (course §5.2.3.1: each occluder's share of the light summed, over-occluding where "  \
-         "occluders overlap; shares measured with the same samples)",                                                \
-         accumulate_names},                                                                                          \
-        {"tiles", PARAM_INT, 8, 1, 16, "tiles",                                                                      \
-         "light samples: a tiles x tiles tiling of the 2 x 2 rotated grid (RGSS), N = 4 tiles^2 (8: the course's "   \
-         "256; 16: 1024)",                                                                                           \
-         NULL},                                                                                                      \
-    {                                                                                                                \
-        "budget", PARAM_INT, 32, 2, BP_MAX_BUDGET, "lexels",                                                         \
-            "texel budget T (course §5.2.3.5, Fig. 5.11): the search area is read at the finest min-pyramid level "  \
-            "whose window is at most T lexels a side (cost O(T^2) per receiver; aux `level`)",                       \
-            NULL                                                                                                     \
-    }
+#define BP_PARAMS                                                                                                 \
+    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_CUBE, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT), SMAP_BIAS_PARAMS_PLANE(1),        \
+    {"occluder", PARAM_ENUM, OCC_MICROQUAD, 0, 2, "",                                                              \
+     "occluder representation (course §5.2.3.3): micropatch (each lexel's square at its depth: over-occludes, "   \
+     "keeps one-texel twigs), microquad (quads of 2 x 2 lexel centres, all four in front: no gaps, misses "        \
+     "one-texel twigs; the course's recommendation with bitmasks) or microtri (also triangles of three of four)",  \
+     occluder_names},                                                                                              \
+    {"gaps", PARAM_ENUM, GAPS_DIAGONAL, 0, 2, "",                                                                  \
+     "occluder=micropatch: gap filling (course §5.2.3.3): none (neighbouring patches at different depths leave "   \
+     "slits that leak light), guennebaud (each patch extended to its left and bottom neighbours', Guennebaud "     \
+     "2006) or diagonal (also its bottom-left corner to the diagonal neighbour's, Bavoil 2008)",                   \
+     gaps_names},                                                                                                  \
+    {"accumulate", PARAM_ENUM, ACC_BITMASK, 0, 1, "",                                                              \
+     "bitmask (Schwarz & Stamminger 2007: one bit per light sample, the union of the occluders' masks, V = 1 - "   \
+     "popcount / N) or area (course §5.2.3.1: each occluder's share of the light summed, over-occluding where "    \
+     "occluders overlap; shares measured with the same samples)",                                                  \
+     accumulate_names},                                                                                            \
+    {"tiles", PARAM_INT, 8, 1, 16, "tiles",                                                                        \
+     "light samples: a tiles x tiles tiling of the 2 x 2 rotated grid (RGSS), N = 4 tiles^2 (8: the course's "     \
+     "256; 16: 1024)",                                                                                             \
+     NULL},                                                                                                        \
+    {"budget", PARAM_INT, 32, 2, BP_MAX_BUDGET, "lexels",                                                          \
+     "texel budget T (course §5.2.3.5, Fig. 5.11): the search area is read at the finest level (min-pyramid "      \
+     "nodes; in mssm and ysm MSSM windows above their base) whose window is at most T lexels a side (cost "        \
+     "O(T^2) per receiver; aux `level`)",                                                                          \
+     NULL}
 
 /* The multiscale variants' own (course §5.2.3.4-5). */
-#define MS_PARAMS                                                                                                   \
-    {"early_out", PARAM_ENUM, EARLY_BOTH, 0, 2, "",                                                                  \
-     "course §5.2.3.4's early outs before any backprojection: both (lit where z_p <= z_min over the search area; "   \
-     "umbra where every texel of it passes the shadow test, z_max in front of the smallest reference), lit only, "   \
-     "or none (every receiver backprojected: the early outs' effect measured against it; aux `class`)",              \
-     early_out_names},                                                                                               \
-    {                                                                                                                \
-        "blend", PARAM_BOOL, 0, 0, 1, "",                                                                            \
-            "level blending (course §5.2.3.5: level switches show, Fig. 5.11f): mix the budget's level L with L + 1 " \
-            "by t = log2(span / T) - (L - 1), span the area's width in texels, so V is continuous where L switches " \
-            "(at most 1.25 x the cost; the coarser level stays within the budget)",                                  \
-            NULL                                                                                                     \
-    }
+#define MS_PARAMS                                                                                                 \
+    {"early_out", PARAM_ENUM, EARLY_BOTH, 0, 2, "",                                                                \
+     "course §5.2.3.4's early outs before any backprojection: both (lit where z_p <= z_min over the search area; " \
+     "umbra where every texel of it passes the shadow test, z_max in front of the smallest reference), lit only, " \
+     "or none (every receiver backprojected: the early outs' effect measured against it; aux `class`)",            \
+     early_out_names},                                                                                             \
+    {"blend", PARAM_BOOL, 0, 0, 1, "",                                                                             \
+     "level blending (course §5.2.3.5: level switches show, Fig. 5.11f): mix the budget's level L with L + 1 by "  \
+     "t = log2(span / T) - (L - 1), span the area's width in texels, so V is continuous where L switches (at "     \
+     "most 1.25 x the cost; the coarser level stays within the budget)",                                           \
+     NULL}
 
 static const ParamDesc bp_params[] = {BP_PARAMS};
 static const ParamDesc ms_params[] = {BP_PARAMS, MS_PARAMS};
@@ -183,39 +180,58 @@ static void face_samples(const SoftLight *L, int tiles, int n, FaceSamples *fs)
     for (int k = 0; k < n; k++) fs->index[fill[cell[k]]++] = (short)k;
 }
 
-/* The MSSM's base level (course §5.2.3.4: 0 for mssm, n - 1 for ysm),
- * refused where it leaves more than MINMAX_LEVELS_MAX_RES^2 nodes or lies
- * beyond the pyramid; -1: none (backprojection, hsm). */
-static bool mssm_base(Variant var, const double *p, const MinMaxPyramid *pyr, int *base, Error *err)
+/* Nodes per side of pyramid level `level` over a res^2 map, and the
+ * pyramid's level count (res_minmax_pyramid: sizes halve, rounding up, to 1). */
+static int pyramid_size(int res, int level)
 {
+    while (level-- > 0) res = (res + 1) / 2;
+    return res;
+}
+
+static int pyramid_levels(int res)
+{
+    int n = 1;
+    for (; res > 1; n++) res = (res + 1) / 2;
+    return n;
+}
+
+/* The MSSM's base level (course §5.2.3.4: 0 for mssm, n - 1 for ysm),
+ * refused, before any map is drawn, where it leaves more than
+ * MINMAX_LEVELS_MAX_RES^2 nodes or lies beyond the pyramid; -1: none
+ * (backprojection, hsm). */
+static bool mssm_base(Variant var, const double *p, int *base, Error *err)
+{
+    int res = (int)p[SMAP_P_MAP_SIZE], levels = pyramid_levels(res);
     *base = var == VAR_MSSM ? 0 : var == VAR_YSM ? (int)p[P_HSM_LEVELS] - 1 : -1;
     if (*base < 0) return true;
-    if (*base >= pyr->levels)
+    if (*base >= levels)
         return error_set(err, "hsm_levels %d above the %d levels of a map_size %d pyramid: range [1, %d] here",
-                         *base + 1, pyr->levels, pyr->res, pyr->levels);
-    if (pyr->size[*base] <= MINMAX_LEVELS_MAX_RES) return true;
+                         *base + 1, levels, res, levels);
+    if (pyramid_size(res, *base) <= MINMAX_LEVELS_MAX_RES) return true;
     if (var == VAR_MSSM)
         return error_set(err,
                          "map_size %d above %d: the MSSM's full-resolution levels are 'too expensive for ... "
                          "greater than 1024^2' (course §5.2.3.4); map_size range [1, %d] here (ysm reads larger maps)",
-                         pyr->res, MINMAX_LEVELS_MAX_RES, MINMAX_LEVELS_MAX_RES);
+                         res, MINMAX_LEVELS_MAX_RES, MINMAX_LEVELS_MAX_RES);
     int need = *base + 1;
-    while (pyr->size[need - 1] > MINMAX_LEVELS_MAX_RES) need++;
+    while (pyramid_size(res, need - 1) > MINMAX_LEVELS_MAX_RES) need++;
     return error_set(err,
                      "hsm_levels %d builds the MSSM on %d^2 nodes (map_size %d), above %d^2 (course §5.2.3.4); "
                      "range [%d, %d] at this map size",
-                     *base + 1, pyr->size[*base], pyr->res, MINMAX_LEVELS_MAX_RES, need, pyr->levels);
+                     *base + 1, pyramid_size(res, *base), res, MINMAX_LEVELS_MAX_RES, need, levels);
 }
 
 static bool prepare_variant(const TechContext *ctx, Variant var, const char *tech, void **state, Error *err)
 {
     const double *p = ctx->params;
+    int base;
+    if (!mssm_base(var, p, &base, err)) return false;
     BpState *st = calloc(1, sizeof *st);
     if (!st) return error_set(err, "out of memory");
+    st->base = base;
     ShadowMapSpec spec = smap_spec(p);
     const ShadowMap *map = res_shadow_map(ctx->rm, ctx->scene, ctx->light_index, &spec, err);
-    bool ok = map && softmap_init(&st->sm, ctx->rm, map, ctx->light, tech, err) &&
-              mssm_base(var, p, st->sm.pyramid, &st->base, err);
+    bool ok = map && softmap_init(&st->sm, ctx->rm, map, ctx->light, tech, err);
     if (ok && st->base >= 0) ok = (st->mssm = res_minmax_levels(ctx->rm, st->sm.pyramid, st->base, err)) != NULL;
     if (!ok) {
         free(st);

@@ -109,8 +109,8 @@ static void class_counts(Lab *lab, const RenderResult *r, long counts[3])
     }
 }
 
-/* Each variant at its defaults (1024^2, budget 32, microquads, 256-sample
- * bitmask) against a 64-sample stratified reference on sphere-on-plane,
+/* Each variant at its defaults (1024^2 cube map, budget 32, microquads,
+ * 256-sample bitmask; mssm's levels take 528 MiB) against a 64-sample stratified reference on sphere-on-plane,
  * 160 x 120. Measured: penumbra RMSE 0.0581 (hsm), 0.0571 (mssm), 0.0573
  * (ysm), against the reference's own noise 0.042; umbra leak <= 0.0020;
  * all-sample RMSE 0.0130. The bounds leave ~20% (penumbra 0.07, all 0.016)
@@ -199,14 +199,14 @@ TEST(test_multiscale_early_outs_match_full_backprojection)
  * exact window bounds (and YSM's, above its HSM levels) are never looser
  * than HSM's 2 x 2 nodes, so they classify at least as many receivers by
  * early out; measured on spheres.lua (procedural, the default) and the
- * bunny when SHADOWLAB_MODEL_PATH holds it (160 x 120, map 1024). */
+ * bunny when SHADOWLAB_MODEL_PATH holds it (160 x 120, map 512). */
 static void classification_shares(Lab *lab, const char *name)
 {
     long early[NUM_VARIANTS], total = 0;
     for (int v = 0; v < NUM_VARIANTS; v++) {
-        const char *none[] = {NULL};
+        const char *p[] = {"map_size=512", NULL};
         RenderResult r;
-        CHECK(soft_render(lab, variants[v], none, &r));
+        CHECK(soft_render(lab, variants[v], p, &r));
         long c[3];
         class_counts(lab, &r, c);
         total = c[0] + c[1] + c[2];
