@@ -106,8 +106,9 @@ enum { CLASS_LIT, CLASS_UMBRA, CLASS_BACKPROJECTED }; /* aux `class` */
      early_out_names},                                                                                             \
     {"blend", PARAM_BOOL, 0, 0, 1, "",                                                                             \
      "level blending (course §5.2.3.5: level switches show, Fig. 5.11f): mix the budget's level L with L + 1 by "  \
-     "t = log2(span / T) - (L - 1), span the area's width in texels, so V is continuous where L switches (at "     \
-     "most 1.25 x the cost; the coarser level stays within the budget)",                                           \
+     "t = log2(span / T) - (L - 1), span the area's width in texels: V is continuous where L switches as span "   \
+     "grows continuously, not where span jumps (a nearer blocker entering the area; measured in "                  \
+     "experiments/course-fig5.10-5.11-multiscale.lua); at most 1.25 x the cost, within the budget",                \
      NULL}
 
 static const ParamDesc bp_params[] = {BP_PARAMS};
@@ -357,7 +358,8 @@ static double win_z(const Window *w, int a, int b) { return w->z[b][a]; }
  * lexel at each end), and, for blending, the weight t of level L + 1:
  * lambda = log2(span / T) lies in [L - 1, L) (L > 0), t = lambda - (L - 1),
  * so t -> 1 as L is about to switch to L + 1 and is 0 just after: V is
- * continuous across the switch (course §5.2.3.5). 0 at the top level. */
+ * continuous across a switch where span is (course §5.2.3.5); span itself
+ * jumps where z_min over the area does. 0 at the top level. */
 static int budget_level(const BpState *st, int wi, int wj, double *t)
 {
     int level = 0, top = st->sm.pyramid->levels - 1, span = 2 * (wi > wj ? wi : wj) + 1;
