@@ -376,7 +376,7 @@ static void load_window(const BpState *st, const SmapReceiver *r, int wi, int wj
     int i, j;
     smap_texel(r, &i, &j);
     Grid g = lexel_grid(st, level, i, j);
-    int oi = g.k < 0 ? 0 : g.oi << st->base, oj = g.k < 0 ? 0 : g.oj << st->base; /* lexel 0's first texel */
+    int oi = g.k < 0 ? 0 : g.oi * (1 << st->base), oj = g.k < 0 ? 0 : g.oj * (1 << st->base); /* lexel 0's texel */
     int i0 = (int)floor((double)(i - wi - oi) / scale), i1 = (int)floor((double)(i + wi - oi) / scale);
     int j0 = (int)floor((double)(j - wj - oj) / scale), j1 = (int)floor((double)(j + wj - oj) / scale);
     w->level = level;
