@@ -118,8 +118,8 @@ static const ParamDesc ysm_params[] = {
     MS_PARAMS,
     {"hsm_levels", PARAM_INT, 3, 1, BP_MAX_HSM_LEVELS, "levels",
      "n of course §5.2.3.4's YSM: the min-max pyramid's levels 0 .. n - 1 as in hsm, an MSSM built on level n - 1 "
-     "for every coarser query (1: mssm; the map's level count: the MSSM of one node, i.e. hsm); at most the "
-     "pyramid's levels, and the MSSM's level at most 1024^2 nodes",
+     "for every coarser query (1: mssm; the map's level count or more: the MSSM of the top level's one node, "
+     "i.e. hsm); the MSSM's level at most 1024^2 nodes",
      NULL},
 };
 
@@ -196,18 +196,16 @@ static int pyramid_levels(int res)
     return n;
 }
 
-/* The MSSM's base level (course §5.2.3.4: 0 for mssm, n - 1 for ysm),
+/* The MSSM's base level (course §5.2.3.4: 0 for mssm, n - 1 for ysm, at
+ * most the pyramid's top level, where the MSSM of one node is hsm),
  * refused, before any map is drawn, where it leaves more than
- * MINMAX_LEVELS_MAX_RES^2 nodes or lies beyond the pyramid; -1: none
- * (backprojection, hsm). */
+ * MINMAX_LEVELS_MAX_RES^2 nodes; -1: none (backprojection, hsm). */
 static bool mssm_base(Variant var, const double *p, int *base, Error *err)
 {
     int res = (int)p[SMAP_P_MAP_SIZE], levels = pyramid_levels(res);
     *base = var == VAR_MSSM ? 0 : var == VAR_YSM ? (int)p[P_HSM_LEVELS] - 1 : -1;
     if (*base < 0) return true;
-    if (*base >= levels)
-        return error_set(err, "hsm_levels %d above the %d levels of a map_size %d pyramid: range [1, %d] here",
-                         *base + 1, levels, res, levels);
+    if (*base > levels - 1) *base = levels - 1;
     if (pyramid_size(res, *base) <= MINMAX_LEVELS_MAX_RES) return true;
     if (var == VAR_MSSM)
         return error_set(err,
