@@ -298,6 +298,10 @@ static const KnownLimit inside_occluder_known[] = {
     {"aliasing", ONE_SIDED, UMBRA_MISSED, ONE_SIDED_MAP},
     /* backprojection 0.218 / 0.217 (rect / disk; sphere 0.0006); occlusion_textures (6 slices) 0.361 / 0.335, sphere 0.021 */
     {"backprojection", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
+    /* hsm 0.218 / 0.217, mssm and ysm 0.217 / 0.217 (rect / disk; sphere 0.0006 each): backprojection's map */
+    {"hsm", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
+    {"mssm", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
+    {"ysm", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
     {"occlusion_textures", LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK), UMBRA_MISSED, ONE_SIDED_MAP},
     {"occlusion_textures", LIGHT_BIT(LIGHT_SPHERE), STAB_Q_UMBRA_LEAK,
      "course §5.2.5: the slices' box-filtered values are multiplied, not united; walls whose depths spread over "

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include "core/hash.h"
 #include "core/nanmath.h"
 
@@ -697,7 +698,7 @@ const MinMaxPyramid *res_minmax_pyramid(ResourceManager *rm, const ShadowMap *ma
     return rm_acquire(rm, &kind_pyramid, a.key, desc, build_pyramid, &a, err);
 }
 
-void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax)
+int minmax_query_level(const MinMaxPyramid *p, int i0, int j0, int i1, int j1)
 {
     i0 = clampi(i0, 0, p->res - 1);
     i1 = clampi(i1, 0, p->res - 1);
@@ -705,6 +706,16 @@ void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int 
     j1 = clampi(j1, 0, p->res - 1);
     int l = 0;
     while (l + 1 < p->levels && ((i1 >> l) - (i0 >> l) > 1 || (j1 >> l) - (j0 >> l) > 1)) l++;
+    return l;
+}
+
+void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax)
+{
+    i0 = clampi(i0, 0, p->res - 1);
+    i1 = clampi(i1, 0, p->res - 1);
+    j0 = clampi(j0, 0, p->res - 1);
+    j1 = clampi(j1, 0, p->res - 1);
+    int l = minmax_query_level(p, i0, j0, i1, j1);
     float lo = INFINITY, hi = -INFINITY;
     for (int j = j0 >> l; j <= j1 >> l; j++)
         for (int i = i0 >> l; i <= i1 >> l; i++) {
@@ -852,4 +863,127 @@ void minmax_buffer_query(const MinMaxBuffer *b, int face, int i0, int j0, int i1
         }
     *zmin = lo;
     *zmax = hi;
+}
+
+/* ---- every N-buffer level of a pyramid level (MSSM) ---- */
+
+static size_t levels_pairs(const MinMaxLevels *m) { return (size_t)m->levels * m->num_faces * m->res * m->res; }
+
+static void levels_destroy(void *r)
+{
+    MinMaxLevels *m = r;
+    free(m->minmax);
+    free(m);
+}
+
+static size_t levels_bytes(const void *r)
+{
+    const MinMaxLevels *m = r;
+    return sizeof *m + levels_pairs(m) * 2 * sizeof(float);
+}
+
+static const ResourceKind kind_levels = {"minmax_levels", levels_bytes, levels_destroy, RES_FRAME};
+
+typedef struct LevelsArgs { const MinMaxPyramid *pyramid; int base; uint64_t key; } LevelsArgs;
+
+static inline const float *levels_entry(const MinMaxLevels *m, int k, int face, int x, int y)
+{
+    return m->minmax + 2 * ((((size_t)k * m->num_faces + face) * m->res + y) * m->res + x);
+}
+
+static void *build_levels(const void *args, Error *err)
+{
+    const LevelsArgs *a = args;
+    const MinMaxPyramid *p = a->pyramid;
+    MinMaxLevels *m = calloc(1, sizeof *m);
+    if (!m) { error_set(err, "out of memory"); return NULL; }
+    *m = (MinMaxLevels){a->key, a->base, p->size[a->base], p->num_faces, 1, NULL};
+    while ((1 << (m->levels - 1)) < m->res) m->levels++;
+    m->minmax = malloc(levels_pairs(m) * 2 * sizeof *m->minmax);
+    if (!m->minmax) {
+        levels_destroy(m);
+        error_set(err, "out of memory for the %d levels of a %d^2 multiscale (MSSM) min-max map", m->levels, m->res);
+        return NULL;
+    }
+    size_t per_level = (size_t)m->num_faces * m->res * m->res;
+    memcpy(m->minmax, node(p, a->base, 0, 0, 0), per_level * 2 * sizeof *m->minmax); /* faces are contiguous */
+    for (int k = 1; k < m->levels; k++) {
+        float *level = m->minmax + 2 * per_level * k;
+        memcpy(level, level - 2 * per_level, per_level * 2 * sizeof *level);
+        buffer_double(level, m->res, m->num_faces, 1 << (k - 1));
+    }
+    return m;
+}
+
+const MinMaxLevels *res_minmax_levels(ResourceManager *rm, const MinMaxPyramid *p, int base, Error *err)
+{
+    if (base < 0 || base >= p->levels) {
+        error_set(err, "multiscale min-max map: base level %d outside the pyramid's [0, %d]", base, p->levels - 1);
+        return NULL;
+    }
+    if (p->size[base] > MINMAX_LEVELS_MAX_RES) {
+        error_set(err,
+                  "multiscale min-max map (MSSM): %d^2 nodes at pyramid level %d, above the bound of %d^2 (course "
+                  "§5.2.3.4: too expensive above 1024^2)",
+                  p->size[base], base, MINMAX_LEVELS_MAX_RES);
+        return NULL;
+    }
+    Hasher h;
+    hash_init(&h);
+    hash_u64(&h, p->key);
+    hash_str(&h, "mssm");
+    hash_u64(&h, (uint64_t)base);
+    LevelsArgs a = {p, base, hash_final(&h)};
+    char desc[160], pk[17];
+    hash_hex(p->key, pk);
+    snprintf(desc, sizeof desc, "multiscale (MSSM) min-max levels of pyramid %s level %d", pk, base);
+    return rm_acquire(rm, &kind_levels, a.key, desc, build_levels, &a, err);
+}
+
+/* The level whose windows are the widest not wider than `width` nodes. */
+static int levels_fit(const MinMaxLevels *m, int width)
+{
+    int k = 0;
+    while (k + 1 < m->levels && (2 << k) <= width) k++;
+    return k;
+}
+
+void minmax_levels_query(const MinMaxLevels *m, int face, int x0, int y0, int x1, int y1, float *zmin, float *zmax)
+{
+    x0 = clampi(x0, 0, m->res - 1);
+    x1 = clampi(x1, 0, m->res - 1);
+    y0 = clampi(y0, 0, m->res - 1);
+    y1 = clampi(y1, 0, m->res - 1);
+    int w = x1 - x0 + 1, h = y1 - y0 + 1, k = levels_fit(m, w < h ? w : h), n = 1 << k;
+    /* windows of n <= width nodes at both ends of each axis; the wider axis
+     * takes as many more as it needs (overlaps are harmless) */
+    float lo = INFINITY, hi = -INFINITY;
+    for (int y = y0;; y = y + n > y1 - n + 1 ? y1 - n + 1 : y + n) {
+        for (int x = x0;; x = x + n > x1 - n + 1 ? x1 - n + 1 : x + n) {
+            const float *q = levels_entry(m, k, face, x, y);
+            lo = nan_minf(lo, q[0]);
+            hi = nan_maxf(hi, q[1]);
+            if (x >= x1 - n + 1) break;
+        }
+        if (y >= y1 - n + 1) break;
+    }
+    *zmin = lo;
+    *zmax = hi;
+}
+
+float minmax_levels_min(const MinMaxLevels *m, int face, int k, int *x, int *y)
+{
+    *x = clampi(*x, 0, m->res - 1);
+    *y = clampi(*y, 0, m->res - 1);
+    float lo = levels_entry(m, k, face, *x, *y)[0];
+    for (int l = k; l > 0; l--) { /* level l = level l - 1 at offsets 0 and h per axis, clamped */
+        int h = 1 << (l - 1), cx = *x, cy = *y;
+        for (int c = 0; c < 4; c++) {
+            int a = clampi(*x + (c & 1) * h, 0, m->res - 1), b = clampi(*y + (c >> 1) * h, 0, m->res - 1);
+            if (levels_entry(m, l - 1, face, a, b)[0] == lo) { cx = a; cy = b; break; }
+        }
+        *x = cx;
+        *y = cy;
+    }
+    return lo;
 }

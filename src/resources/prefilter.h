@@ -145,6 +145,10 @@ const MinMaxPyramid *res_minmax_pyramid(ResourceManager *rm, const ShadowMap *ma
 /* Conservative bounds of the stored depth over texels [i0, i1] x [j0, j1]
  * (clamped to the face: the same texels as an edge-clamped window). */
 void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax);
+/* The level minmax_query reads for texels [i0, i1] x [j0, j1] (clamped to
+ * the face): the finest whose nodes cover them with at most 2 x 2 (HSM's
+ * query, course §5.2.3.4). */
+int minmax_query_level(const MinMaxPyramid *p, int i0, int j0, int i1, int j1);
 /* The minimum of node (*i, *j) of `level` (clamped to the level's grid: an
  * edge-clamped read), and in *i, *j the level-0 texel that holds it, found by
  * descending through the children (for a test at that texel's own reference:
@@ -168,5 +172,34 @@ const MinMaxBuffer *res_minmax_buffer(ResourceManager *rm, const ShadowMap *map,
 /* Exact bounds over texels [i0, i1] x [j0, j1], clamped to the face
  * (conservative only for windows narrower than a block). */
 void minmax_buffer_query(const MinMaxBuffer *b, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax);
+
+/* Every N-buffer level of one min-max pyramid level `base` (the MSSM of
+ * course §5.2.3.4, Schwarz & Stamminger 2008: "level i holds min/max over a
+ * 2^i x 2^i window ... at full resolution"; YSM's "MSSM from HSM level
+ * n - 1" for base = n - 1): level k holds, at each node (x, y) of the base
+ * level, the min and max over nodes [x, x + 2^k) x [y, y + 2^k), indices
+ * clamped to the face (Decoret 2005's doubling, as res_minmax_buffer),
+ * k = 0 .. levels - 1 with 2^(levels - 1) >= the base level's size. A
+ * window at any position then has exact bounds from 4 entries, and a coarse
+ * lexel needs no alignment to the quadtree. Memory: levels x faces x size^2
+ * pairs of floats, 88 MiB per face at 1024^2; refused above
+ * MINMAX_LEVELS_MAX_RES nodes a side (the course: MSSM is "too expensive
+ * for ... greater than 1024^2"). */
+#define MINMAX_LEVELS_MAX_RES 1024
+typedef struct MinMaxLevels {
+    uint64_t key;
+    int base, res, num_faces, levels; /* res: nodes per side of the base level */
+    float *minmax;        /* pairs (min, max), [((k * faces + face) * res + y) * res + x] */
+} MinMaxLevels;
+
+const MinMaxLevels *res_minmax_levels(ResourceManager *rm, const MinMaxPyramid *p, int base, Error *err);
+/* Exact bounds over base-level nodes [x0, x1] x [y0, y1], clamped to the
+ * face: the four overlapping windows of level floor(log2 width). */
+void minmax_levels_query(const MinMaxLevels *m, int face, int x0, int y0, int x1, int y1, float *zmin, float *zmax);
+/* The minimum of level k's window at node (*x, *y) (clamped to the face),
+ * and in *x, *y the base-level node that holds it, found by descending
+ * through the four half-size windows each level was doubled from (the
+ * first in scan order on ties). */
+float minmax_levels_min(const MinMaxLevels *m, int face, int k, int *x, int *y);
 
 #endif

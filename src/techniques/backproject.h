@@ -99,13 +99,26 @@ static inline void backproject_search_halfwidth(const SoftMap *sm, const SmapRec
     *wj = rj >= 0.0 ? (int)fmin(rj, sm->map->res) : 0;
 }
 
+/* Bounds (stored depth) over texels [i0, i1] x [j0, j1] of a face from some
+ * min-max structure: the min-max pyramid's 2 x 2 nodes (HSM), or the
+ * multiscale levels of course §5.2.3.4 (MSSM, YSM). */
+typedef void (*BackprojectBounds)(const void *structure, int face, int i0, int j0, int i1, int j1, float *zmin,
+                                  float *zmax);
+
+static inline void backproject_pyramid_bounds(const void *pyramid, int face, int i0, int j0, int i1, int j1,
+                                              float *zmin, float *zmax)
+{
+    minmax_query(pyramid, face, i0, j0, i1, j1, zmin, zmax);
+}
+
 /* The search area (course §5.2.3.4, Fig. 5.9): the light's footprint on the
  * face's near plane, narrowed (three passes) through the plane of the
- * pyramid's minimum z_min over the texels that footprint spans: no blocker
- * of r lies nearer the light than *z_b (world units), so the footprint at
- * *z_b holds every texel that can occlude r. false: nothing in reach can
- * block r (z_p <= z_min: lit). */
-static inline bool backproject_search(const SoftMap *sm, const SmapReceiver *r, double *z_b)
+ * minimum z_min that `bounds` gives over the texels that footprint spans:
+ * no blocker of r lies nearer the light than *z_b (world units), so the
+ * footprint at *z_b holds every texel that can occlude r. false: nothing in
+ * reach can block r (z_p <= z_min: lit); *z_b is then the last plane. */
+static inline bool backproject_search_in(const SoftMap *sm, BackprojectBounds bounds, const void *structure,
+                                         const SmapReceiver *r, double *z_b)
 {
     const SoftFace *f = &sm->face[r->mc.face];
     double r_z = r->mc.depth_linear;
@@ -115,11 +128,19 @@ static inline bool backproject_search(const SoftMap *sm, const SmapReceiver *r, 
     for (int pass = 0; pass < 3 && *z_b < r_z; pass++) {
         int wi, wj;
         backproject_search_halfwidth(sm, r, *z_b, &wi, &wj);
+        float zmin, zmax;
+        bounds(structure, r->mc.face, i - wi, j - wj, i + wi, j + wj, &zmin, &zmax);
         double z_min;
-        if (!softmap_may_block(sm, r, i - wi, j - wj, i + wi, j + wj, &z_min)) return false;
+        if (!softmap_bounds_may_block(sm, r, zmin, i - wi, j - wj, i + wi, j + wj, &z_min)) return false;
         if (z_min > *z_b) *z_b = z_min; /* NaN: not narrowed, the wider area keeps every blocker (issue 13 §1) */
     }
     return true;
+}
+
+/* The search through the map's min-max pyramid (HSM's query). */
+static inline bool backproject_search(const SoftMap *sm, const SmapReceiver *r, double *z_b)
+{
+    return backproject_search_in(sm, backproject_pyramid_bounds, sm->pyramid, r, z_b);
 }
 
 /* Occlusion bitmasks' light samples (Schwarz & Stamminger 2007, course

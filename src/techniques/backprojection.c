@@ -26,7 +26,29 @@
  *     summed, V = 1 - min(1, sum) (§5.2.3.1's summed areas, measured by the
  *     same samples: over-occludes where polygons overlap).
  * Only casters seen from the light's centre exist (one layer; course
- * Fig. 1.8). The light is the scene's (sphere: its central cross-section). */
+ * Fig. 1.8). The light is the scene's (sphere: its central cross-section).
+ *
+ * The multiscale variants of course §5.2.3.4-5 run the same loop on other
+ * min-max structures, which give the search area's bounds and the coarse
+ * lexels the texel budget reads:
+ *   hsm   (Guennebaud et al. 2006) the min-max mip pyramid: bounds from the
+ *         finest level whose nodes cover the area with at most 2 x 2;
+ *         coarse lexels are the pyramid's aligned nodes;
+ *   mssm  (Schwarz & Stamminger 2008) level i the min-max over the 2^i x 2^i
+ *         window at every texel, full resolution (res_minmax_levels): exact
+ *         bounds from 4 windows; coarse lexels are windows centred on the
+ *         receiver's texel, so they move with it (no quadtree seams);
+ *   ysm   the pyramid's first n levels, then an MSSM built on level n - 1.
+ * Each adds to `backprojection`'s lit early out an umbra early out, stated
+ * exactly (course §5.2.3.4 writes "z_p > z_max -> umbra"): the maximum
+ * stored depth over the whole search area lies in front of the smallest
+ * shadow-test reference over it, i.e. every texel of the area passes the
+ * test. Every ray from p to the light leaves the area's pyramid only
+ * nearer the light than the plane z_b, where no caster is; the casters
+ * seen from the centre over the area, all in front of p, then form a
+ * height field that each such ray must cross. Aux `class` records which
+ * path a receiver took (0 lit early out, 1 umbra early out, 2
+ * backprojected); `blend` mixes two budget levels. */
 #include <stdlib.h>
 #include "core/nanmath.h"
 #include "techniques/backproject.h"
@@ -38,42 +60,73 @@ static const char *const gaps_names[] = {"none", "guennebaud", "diagonal", NULL}
 enum { ACC_BITMASK, ACC_AREA };
 static const char *const accumulate_names[] = {"bitmask", "area", NULL};
 
-enum { P_OCCLUDER = SMAP_NUM_PARAMS, P_GAPS, P_ACCUMULATE, P_TILES, P_BUDGET };
+enum { P_OCCLUDER = SMAP_NUM_PARAMS, P_GAPS, P_ACCUMULATE, P_TILES, P_BUDGET, P_EARLY_OUT, P_BLEND, P_HSM_LEVELS };
+enum { EARLY_BOTH, EARLY_LIT, EARLY_NONE };
+static const char *const early_out_names[] = {"both", "lit", "none", NULL};
+enum { CLASS_LIT, CLASS_UMBRA, CLASS_BACKPROJECTED }; /* aux `class` */
 
 #define BP_MAX_BUDGET 256
 #define BP_WORDS (BACKPROJECT_MAX_SAMPLES / 64)
+#define BP_MAX_HSM_LEVELS 15 /* a 16384^2 map's pyramid */
 
 /* Plain perspective faces only (softmap.h): no warps or frustum-face splits. */
-static const ParamDesc bp_params[] = {
-    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_CUBE, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT),
-    SMAP_BIAS_PARAMS_PLANE(1),
-    {"occluder", PARAM_ENUM, OCC_MICROQUAD, 0, 2, "",
-     "occluder representation (course §5.2.3.3): micropatch (each lexel's square at its depth: over-occludes, "
-     "keeps one-texel twigs), microquad (quads of 2 x 2 lexel centres, all four in front: no gaps, misses "
-     "one-texel twigs; the course's recommendation with bitmasks) or microtri (also triangles of three of four)",
-     occluder_names},
-    {"gaps", PARAM_ENUM, GAPS_DIAGONAL, 0, 2, "",
-     "occluder=micropatch: gap filling (course §5.2.3.3): none (neighbouring patches at different depths leave "
-     "slits that leak light), guennebaud (each patch extended to its left and bottom neighbours', Guennebaud "
-     "2006) or diagonal (also its bottom-left corner to the diagonal neighbour's, Bavoil 2008)",
-     gaps_names},
-    {"accumulate", PARAM_ENUM, ACC_BITMASK, 0, 1, "",
-     "bitmask (Schwarz & Stamminger 2007: one bit per light sample, the union of the occluders' masks, V = 1 - "
-     "popcount / N) or area (course §5.2.3.1: each occluder's share of the light summed, over-occluding where "
-     "occluders overlap; shares measured with the same samples)",
-     accumulate_names},
-    {"tiles", PARAM_INT, 8, 1, 16, "tiles",
-     "light samples: a tiles x tiles tiling of the 2 x 2 rotated grid (RGSS), N = 4 tiles^2 (8: the course's "
-     "256; 16: 1024)",
-     NULL},
-    {"budget", PARAM_INT, 32, 2, BP_MAX_BUDGET, "lexels",
-     "texel budget T (course §5.2.3.5, Fig. 5.11): the search area is read at the finest min-pyramid level "
-     "whose window is at most T lexels a side (cost O(T^2) per receiver; aux `level`)",
+#define BP_PARAMS                                                                                                 \
+    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_CUBE, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT), SMAP_BIAS_PARAMS_PLANE(1),        \
+    {"occluder", PARAM_ENUM, OCC_MICROQUAD, 0, 2, "",                                                              \
+     "occluder representation (course §5.2.3.3): micropatch (each lexel's square at its depth: over-occludes, "   \
+     "keeps one-texel twigs), microquad (quads of 2 x 2 lexel centres, all four in front: no gaps, misses "        \
+     "one-texel twigs; the course's recommendation with bitmasks) or microtri (also triangles of three of four)",  \
+     occluder_names},                                                                                              \
+    {"gaps", PARAM_ENUM, GAPS_DIAGONAL, 0, 2, "",                                                                  \
+     "occluder=micropatch: gap filling (course §5.2.3.3): none (neighbouring patches at different depths leave "   \
+     "slits that leak light), guennebaud (each patch extended to its left and bottom neighbours', Guennebaud "     \
+     "2006) or diagonal (also its bottom-left corner to the diagonal neighbour's, Bavoil 2008)",                   \
+     gaps_names},                                                                                                  \
+    {"accumulate", PARAM_ENUM, ACC_BITMASK, 0, 1, "",                                                              \
+     "bitmask (Schwarz & Stamminger 2007: one bit per light sample, the union of the occluders' masks, V = 1 - "   \
+     "popcount / N) or area (course §5.2.3.1: each occluder's share of the light summed, over-occluding where "    \
+     "occluders overlap; shares measured with the same samples)",                                                  \
+     accumulate_names},                                                                                            \
+    {"tiles", PARAM_INT, 8, 1, 16, "tiles",                                                                        \
+     "light samples: a tiles x tiles tiling of the 2 x 2 rotated grid (RGSS), N = 4 tiles^2 (8: the course's "     \
+     "256; 16: 1024)",                                                                                             \
+     NULL},                                                                                                        \
+    {"budget", PARAM_INT, 32, 2, BP_MAX_BUDGET, "lexels",                                                          \
+     "texel budget T (course §5.2.3.5, Fig. 5.11): the search area is read at the finest level (min-pyramid "      \
+     "nodes; in mssm and ysm MSSM windows above their base) whose window is at most T lexels a side (cost "        \
+     "O(T^2) per receiver; aux `level`)",                                                                          \
+     NULL}
+
+/* The multiscale variants' own (course §5.2.3.4-5). */
+#define MS_PARAMS                                                                                                 \
+    {"early_out", PARAM_ENUM, EARLY_BOTH, 0, 2, "",                                                                \
+     "course §5.2.3.4's early outs before any backprojection: both (lit where z_p <= z_min over the search area; " \
+     "umbra where every texel of it passes the shadow test, z_max in front of the smallest reference), lit only, " \
+     "or none (every receiver backprojected: the early outs' effect measured against it; aux `class`)",            \
+     early_out_names},                                                                                             \
+    {"blend", PARAM_BOOL, 0, 0, 1, "",                                                                             \
+     "level blending (course §5.2.3.5: level switches show, Fig. 5.11f): mix the budget's level L with L + 1 by "  \
+     "t = log2(span / T) - (L - 1), span the area's width in texels: V is continuous where L switches as span "   \
+     "grows continuously, not where span jumps (a nearer blocker entering the area; measured in "                  \
+     "experiments/course-fig5.10-5.11-multiscale.lua); at most 1.25 x the cost, within the budget",                \
+     NULL}
+
+static const ParamDesc bp_params[] = {BP_PARAMS};
+static const ParamDesc ms_params[] = {BP_PARAMS, MS_PARAMS};
+static const ParamDesc ysm_params[] = {
+    BP_PARAMS,
+    MS_PARAMS,
+    {"hsm_levels", PARAM_INT, 3, 1, BP_MAX_HSM_LEVELS, "levels",
+     "n of course §5.2.3.4's YSM: the min-max pyramid's levels 0 .. n - 1 as in hsm, an MSSM built on level n - 1 "
+     "for every coarser query (1: mssm; the map's level count or more: the MSSM of the top level's one node, "
+     "i.e. hsm); the MSSM's level at most 1024^2 nodes",
      NULL},
 };
 
 static const char *const bp_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", NULL};
+static const char *const ms_resources[] = {"shadow_map", "minmax_pyramid", "minmax_levels", "view_samples", NULL};
 static const char *const bp_aux[] = {"level", NULL};
+static const char *const ms_aux[] = {"class", "level", NULL};
 
 /* The light's samples on one face's light plane (world units, face axes),
  * bucketed on a G x G grid over the light's bounding box, so a polygon
@@ -90,8 +143,15 @@ typedef struct BpState {
     SoftMap sm;
     SmapBias bias;
     int occluder, gaps, accumulate, budget, samples;
+    int early_out;
+    bool blend, classify;     /* classify: aux `class` precedes `level` */
+    const MinMaxLevels *mssm; /* NULL: the pyramid's aligned nodes only (backprojection, hsm) */
+    int base;                 /* the pyramid level mssm is built on */
     FaceSamples face[LIGHTVIEW_MAX_FACES];
 } BpState;
+
+/* Which min-max structure a technique reads. */
+typedef enum Variant { VAR_BACKPROJECTION, VAR_HSM, VAR_MSSM, VAR_YSM } Variant;
 
 static int grid_cell(double v, double v0, double cell)
 {
@@ -121,14 +181,58 @@ static void face_samples(const SoftLight *L, int tiles, int n, FaceSamples *fs)
     for (int k = 0; k < n; k++) fs->index[fill[cell[k]]++] = (short)k;
 }
 
-static bool bp_prepare(const TechContext *ctx, void **state, Error *err)
+/* Nodes per side of pyramid level `level` over a res^2 map, and the
+ * pyramid's level count (res_minmax_pyramid: sizes halve, rounding up, to 1). */
+static int pyramid_size(int res, int level)
+{
+    while (level-- > 0) res = (res + 1) / 2;
+    return res;
+}
+
+static int pyramid_levels(int res)
+{
+    int n = 1;
+    for (; res > 1; n++) res = (res + 1) / 2;
+    return n;
+}
+
+/* The MSSM's base level (course §5.2.3.4: 0 for mssm, n - 1 for ysm, at
+ * most the pyramid's top level, where the MSSM of one node is hsm),
+ * refused, before any map is drawn, where it leaves more than
+ * MINMAX_LEVELS_MAX_RES^2 nodes; -1: none (backprojection, hsm). */
+static bool mssm_base(Variant var, const double *p, int *base, Error *err)
+{
+    int res = (int)p[SMAP_P_MAP_SIZE], levels = pyramid_levels(res);
+    *base = var == VAR_MSSM ? 0 : var == VAR_YSM ? (int)p[P_HSM_LEVELS] - 1 : -1;
+    if (*base < 0) return true;
+    if (*base > levels - 1) *base = levels - 1;
+    if (pyramid_size(res, *base) <= MINMAX_LEVELS_MAX_RES) return true;
+    if (var == VAR_MSSM)
+        return error_set(err,
+                         "map_size %d above %d: the MSSM's full-resolution levels are 'too expensive for ... "
+                         "greater than 1024^2' (course §5.2.3.4); map_size range [1, %d] here (ysm reads larger maps)",
+                         res, MINMAX_LEVELS_MAX_RES, MINMAX_LEVELS_MAX_RES);
+    int need = *base + 1;
+    while (pyramid_size(res, need - 1) > MINMAX_LEVELS_MAX_RES) need++;
+    return error_set(err,
+                     "hsm_levels %d builds the MSSM on %d^2 nodes (map_size %d), above %d^2 (course §5.2.3.4); "
+                     "range [%d, %d] at this map size",
+                     *base + 1, pyramid_size(res, *base), res, MINMAX_LEVELS_MAX_RES, need, levels);
+}
+
+static bool prepare_variant(const TechContext *ctx, Variant var, const char *tech, void **state, Error *err)
 {
     const double *p = ctx->params;
+    int base;
+    if (!mssm_base(var, p, &base, err)) return false;
     BpState *st = calloc(1, sizeof *st);
     if (!st) return error_set(err, "out of memory");
+    st->base = base;
     ShadowMapSpec spec = smap_spec(p);
     const ShadowMap *map = res_shadow_map(ctx->rm, ctx->scene, ctx->light_index, &spec, err);
-    if (!map || !softmap_init(&st->sm, ctx->rm, map, ctx->light, "backprojection", err)) {
+    bool ok = map && softmap_init(&st->sm, ctx->rm, map, ctx->light, tech, err);
+    if (ok && st->base >= 0) ok = (st->mssm = res_minmax_levels(ctx->rm, st->sm.pyramid, st->base, err)) != NULL;
+    if (!ok) {
         free(st);
         return false;
     }
@@ -137,6 +241,9 @@ static bool bp_prepare(const TechContext *ctx, void **state, Error *err)
     st->gaps = (int)p[P_GAPS];
     st->accumulate = (int)p[P_ACCUMULATE];
     st->budget = (int)p[P_BUDGET];
+    st->classify = var != VAR_BACKPROJECTION;
+    st->early_out = st->classify ? (int)p[P_EARLY_OUT] : EARLY_LIT;
+    st->blend = st->classify && p[P_BLEND] != 0.0;
     int tiles = (int)p[P_TILES];
     st->samples = 4 * tiles * tiles;
     for (int k = 0; k < map->num_faces; k++) face_samples(&st->sm.face[k].light, tiles, st->samples, &st->face[k]);
@@ -144,7 +251,92 @@ static bool bp_prepare(const TechContext *ctx, void **state, Error *err)
     return true;
 }
 
-/* The occluder samples of one receiver: the search window at one pyramid
+static bool bp_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    return prepare_variant(ctx, VAR_BACKPROJECTION, "backprojection", state, err);
+}
+static bool hsm_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    return prepare_variant(ctx, VAR_HSM, "hsm", state, err);
+}
+static bool mssm_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    return prepare_variant(ctx, VAR_MSSM, "mssm", state, err);
+}
+static bool ysm_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    return prepare_variant(ctx, VAR_YSM, "ysm", state, err);
+}
+
+static int clamp_texel(int v, int res) { return v < 0 ? 0 : v >= res ? res - 1 : v; }
+
+/* Bounds (stored depth) over texels [i0, i1] x [j0, j1] (BackprojectBounds):
+ * the pyramid's 2 x 2 nodes of the finest level that covers them (HSM),
+ * unless an MSSM is built on a level no finer than that one: then its
+ * exact bounds over the base-level nodes the texels lie in (course
+ * §5.2.3.4's YSM switch; mssm: always). Either bounds every texel. */
+static void ms_bounds(const void *state, int face, int i0, int j0, int i1, int j1, float *zmin, float *zmax)
+{
+    const BpState *st = state;
+    const MinMaxPyramid *pyr = st->sm.pyramid;
+    if (!st->mssm || minmax_query_level(pyr, i0, j0, i1, j1) < st->base) {
+        minmax_query(pyr, face, i0, j0, i1, j1, zmin, zmax);
+        return;
+    }
+    int b = st->base, res = pyr->res;
+    minmax_levels_query(st->mssm, face, clamp_texel(i0, res) >> b, clamp_texel(j0, res) >> b,
+                        clamp_texel(i1, res) >> b, clamp_texel(j1, res) >> b, zmin, zmax);
+}
+
+/* The umbra early out, exactly: every texel of [i - wi, i + wi] x [j - wj,
+ * j + wj] passes the shadow test, i.e. the area's largest stored depth lies
+ * in front of its smallest reference (affine in (s, t) or reciprocally so:
+ * at a corner). NaN or an empty texel (+INFINITY): no early out. */
+static bool area_occludes(const BpState *st, const SmapReceiver *r, int wi, int wj)
+{
+    int i, j;
+    smap_texel(r, &i, &j);
+    float zmin, zmax;
+    ms_bounds(st, r->mc.face, i - wi, j - wj, i + wi, j + wj, &zmin, &zmax);
+    double ref = nan_min(nan_min(smap_ref_at(r, i - wi, j - wj), smap_ref_at(r, i + wi, j - wj)),
+                         nan_min(smap_ref_at(r, i - wi, j + wj), smap_ref_at(r, i + wi, j + wj)));
+    return smap_test(ref, zmax) == 0.0f;
+}
+
+/* The lexel grid of budget level L (lexels 2^L texels wide): the
+ * pyramid's aligned nodes (no MSSM, or L <= its base), or MSSM windows of
+ * 2^k base nodes, k = L - base, the grid's lexel 0 centred on the
+ * receiver's base node (course §5.2.3.4: windows "centred on each texel"),
+ * so it moves with the receiver and has no quadtree seams. */
+typedef struct Grid {
+    int level, k;  /* k: MSSM level, -1 for pyramid nodes */
+    int oi, oj;    /* base node where lexel 0 starts (MSSM); 0 for pyramid nodes */
+} Grid;
+
+static Grid lexel_grid(const BpState *st, int level, int i, int j)
+{
+    Grid g = {level, -1, 0, 0};
+    if (!st->mssm || level <= st->base) return g;
+    g.k = level - st->base;
+    g.oi = (i >> st->base) - (1 << (g.k - 1)); /* i, j on the face: a receiver's texel */
+    g.oj = (j >> st->base) - (1 << (g.k - 1));
+    return g;
+}
+
+/* The minimum stored depth of lexel (*i, *j) of the grid, and in *i, *j the
+ * level-0 texel that holds it (seed 000's closest caster of a coarse
+ * lexel, tested at that texel's own reference). */
+static float lexel_min(const BpState *st, int face, const Grid *g, int *i, int *j)
+{
+    if (g->k < 0) return minmax_node_min(st->sm.pyramid, face, g->level, i, j);
+    *i = g->oi + *i * (1 << g->k);
+    *j = g->oj + *j * (1 << g->k);
+    float lo = minmax_levels_min(st->mssm, face, g->k, i, j); /* *i, *j: the base node */
+    minmax_node_min(st->sm.pyramid, face, st->base, i, j);    /* the same minimum, down to its texel */
+    return lo;
+}
+
+/* The occluder samples of one receiver: the search window at one budget
  * level, with a border of one lexel (gap filling and quads read their
  * neighbours), each lexel's caster depth (world units), +INFINITY where
  * its closest texel does not lie in front of p, NaN where the test reads a
@@ -152,29 +344,39 @@ static bool bp_prepare(const TechContext *ctx, void **state, Error *err)
 typedef struct Window {
     int level, i0, j0, w, h; /* first lexel (border included) and size */
     double dx, dy;           /* lexel size, tangent units */
-    double l, b;             /* tangent of lexel edge 0 */
+    double l, b;             /* tangent of lexel 0's low edge */
     double u, v, p_z;        /* the receiver's tangents and depth */
     double z[BP_MAX_BUDGET + 3][BP_MAX_BUDGET + 3];
 } Window;
 
 static double win_z(const Window *w, int a, int b) { return w->z[b][a]; }
 
-/* The finest level whose window of 2 wi + 1 texels fits the budget. */
-static int budget_level(const BpState *st, int wi, int wj)
+/* The finest level whose window of span = 2 max(wi, wj) + 1 texels fits the
+ * budget T (span < T 2^L: at most T lexels, one more where the grid cuts a
+ * lexel at each end), and, for blending, the weight t of level L + 1:
+ * lambda = log2(span / T) lies in [L - 1, L) (L > 0), t = lambda - (L - 1),
+ * so t -> 1 as L is about to switch to L + 1 and is 0 just after: V is
+ * continuous across a switch where span is (course §5.2.3.5); span itself
+ * jumps where z_min over the area does. 0 at the top level. */
+static int budget_level(const BpState *st, int wi, int wj, double *t)
 {
-    int level = 0, span = 2 * (wi > wj ? wi : wj) + 1;
-    while (level + 1 < st->sm.pyramid->levels && (span >> level) + 1 > st->budget) level++;
+    int level = 0, top = st->sm.pyramid->levels - 1, span = 2 * (wi > wj ? wi : wj) + 1;
+    while (level < top && (span >> level) + 1 > st->budget) level++;
+    double frac = log2((double)span / st->budget) - (level - 1);
+    *t = level < top ? fmin(fmax(frac, 0.0), 1.0) : 0.0; /* span, budget >= 1: frac finite */
     return level;
 }
 
-static void load_window(const BpState *st, const SmapReceiver *r, int wi, int wj, Window *w)
+static void load_window(const BpState *st, const SmapReceiver *r, int wi, int wj, int level, Window *w)
 {
     const SoftFace *f = &st->sm.face[r->mc.face];
-    int level = budget_level(st, wi, wj), scale = 1 << level;
+    int scale = 1 << level;
     int i, j;
     smap_texel(r, &i, &j);
-    int i0 = (int)floor((double)(i - wi) / scale), i1 = (int)floor((double)(i + wi) / scale);
-    int j0 = (int)floor((double)(j - wj) / scale), j1 = (int)floor((double)(j + wj) / scale);
+    Grid g = lexel_grid(st, level, i, j);
+    int oi = g.k < 0 ? 0 : g.oi * (1 << st->base), oj = g.k < 0 ? 0 : g.oj * (1 << st->base); /* lexel 0's texel */
+    int i0 = (int)floor((double)(i - wi - oi) / scale), i1 = (int)floor((double)(i + wi - oi) / scale);
+    int j0 = (int)floor((double)(j - wj - oj) / scale), j1 = (int)floor((double)(j + wj - oj) / scale);
     w->level = level;
     w->i0 = i0 - 1;
     w->j0 = j0 - 1;
@@ -182,15 +384,15 @@ static void load_window(const BpState *st, const SmapReceiver *r, int wi, int wj
     w->h = j1 - j0 + 3;
     w->dx = f->dx * scale;
     w->dy = f->dy * scale;
-    w->l = f->l;
-    w->b = f->b;
+    w->l = f->l + oi * f->dx;
+    w->b = f->b + oj * f->dy;
     w->u = f->l + r->mc.s * f->dx;
     w->v = f->b + r->mc.t * f->dy;
     w->p_z = r->mc.depth_linear;
     for (int b = 0; b < w->h; b++)
         for (int a = 0; a < w->w; a++) {
             int ti = w->i0 + a, tj = w->j0 + b; /* off the face: edge-clamped, as every window of the map */
-            float stored = minmax_node_min(st->sm.pyramid, r->mc.face, level, &ti, &tj); /* keeps NaN */
+            float stored = lexel_min(st, r->mc.face, &g, &ti, &tj); /* keeps NaN */
             float lit = smap_test(smap_ref_at(r, ti, tj), stored);
             w->z[b][a] = lit == 0.0f ? smap_linear_depth(st->sm.map, r->mc.face, stored) : lit == 1.0f ? INFINITY : NAN;
         }
@@ -321,33 +523,47 @@ static double window_visibility(const BpState *st, const FaceSamples *fs, const 
     return marked == st->samples ? 0.0 : unknown ? NAN : 1.0 - (double)marked / st->samples;
 }
 
-static float visibility(const BpState *st, const SmapReceiver *r, Window *w, int *level)
+/* Visibility of one receiver; *cls its path (aux `class`), *level the budget level read. */
+static float visibility(const BpState *st, const SmapReceiver *r, Window *w, int *cls, int *level)
 {
-    double z_b;
-    *level = 0;
-    if (!backproject_search(&st->sm, r, &z_b)) return 1.0f; /* z_p <= z_min over the search area: lit */
+    double z_b, t;
+    bool may_block = backproject_search_in(&st->sm, ms_bounds, st, r, &z_b);
     int wi, wj;
     backproject_search_halfwidth(&st->sm, r, z_b, &wi, &wj);
-    load_window(st, r, wi, wj, w);
-    *level = w->level;
-    return (float)window_visibility(st, &st->face[r->mc.face], w);
+    *level = 0;
+    *cls = CLASS_LIT;
+    if (!may_block && st->early_out != EARLY_NONE) return 1.0f; /* z_p <= z_min over the search area: lit */
+    *cls = CLASS_UMBRA;
+    if (st->early_out == EARLY_BOTH && area_occludes(st, r, wi, wj)) return 0.0f;
+    *cls = CLASS_BACKPROJECTED;
+    *level = budget_level(st, wi, wj, &t);
+    load_window(st, r, wi, wj, *level, w);
+    double v = window_visibility(st, &st->face[r->mc.face], w);
+    if (st->blend && t > 0.0) { /* course §5.2.3.5: blending two levels hides the switch */
+        load_window(st, r, wi, wj, *level + 1, w);
+        v = (1.0 - t) * v + t * window_visibility(st, &st->face[r->mc.face], w);
+    }
+    return (float)v;
 }
 
 static void bp_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
 {
     const BpState *st = state;
+    int channels = st->classify ? 2 : 1; /* ms_aux or bp_aux */
     Window *w = malloc(sizeof *w);
     for (int s = begin; s < end; s++) {
         if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
         SmapReceiver r;
-        float v = 1.0f; /* outside the map nothing is known to block: lit */
-        int level = 0;
+        float v = 1.0f; /* outside the map nothing is known to block: lit, as a lit early out */
+        int level = 0, cls = CLASS_LIT;
         if (w && smap_receiver(st->sm.map, &st->bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r))
-            v = visibility(st, &r, w, &level);
+            v = visibility(st, &r, w, &cls, &level);
         else if (!w)
             v = NAN; /* out of memory: no value, never a made-up one */
         tech_store(ctx, out, begin, s, v);
-        if (ctx->aux) ctx->aux[s] = (float)level;
+        if (!ctx->aux) continue;
+        if (st->classify) ctx->aux[(size_t)s * channels] = (float)cls;
+        ctx->aux[(size_t)s * channels + channels - 1] = (float)level;
     }
     free(w);
 }
@@ -358,10 +574,16 @@ static const ParamCondition bp_conditions[] = {
     {NULL, NULL},
 };
 
+/* What the four techniques share. */
+#define BP_TECHNIQUE                                                                                                \
+    .conditions = bp_conditions, .family = "soft", .rgb = false,                                                     \
+    .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),                               \
+    .main_param = "budget", /* course Fig. 5.11: accuracy against the texel budget */                                \
+        .evaluate = bp_evaluate, .release = free
+
 const Technique tech_backprojection = {
-    .conditions = bp_conditions,
+    BP_TECHNIQUE,
     .name = "backprojection",
-    .family = "soft",
     .source = "course §5.2.3.1-3 (Guennebaud et al. 2006; Bavoil & Silva 2006), occlusion bitmasks §5.2.3.2 "
               "(Schwarz & Stamminger 2007)",
     .summary = "occluder samples of the map's search area (refined through z_min) as micropatches, microquads or "
@@ -371,10 +593,45 @@ const Technique tech_backprojection = {
     .num_params = (int)(sizeof bp_params / sizeof bp_params[0]),
     .resources = bp_resources,
     .aux = bp_aux,
-    .rgb = false,
-    .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),
-    .main_param = "budget", /* course Fig. 5.11: accuracy against the texel budget */
     .prepare = bp_prepare,
-    .evaluate = bp_evaluate,
-    .release = free,
+};
+
+const Technique tech_hsm = {
+    BP_TECHNIQUE,
+    .name = "hsm",
+    .source = "course §5.2.3.4-5 (hierarchical shadow map, Guennebaud et al. 2006; texel budget Fig. 5.11)",
+    .summary = "backprojection whose search area is bounded by the min-max mip pyramid's 2 x 2 nodes: lit and "
+               "umbra early outs, then the budget's pyramid level backprojected (aux class and level)",
+    .params = ms_params,
+    .num_params = (int)(sizeof ms_params / sizeof ms_params[0]),
+    .resources = bp_resources,
+    .aux = ms_aux,
+    .prepare = hsm_prepare,
+};
+
+const Technique tech_mssm = {
+    BP_TECHNIQUE,
+    .name = "mssm",
+    .source = "course §5.2.3.4-5 (multi-scale shadow map, Schwarz & Stamminger 2008; texel budget Fig. 5.11)",
+    .summary = "backprojection on min-max windows of 2^i texels at every texel and level (full resolution, maps "
+               "up to 1024^2): exact bounds for the lit and umbra early outs, budget lexels centred on the "
+               "receiver (aux class and level)",
+    .params = ms_params,
+    .num_params = (int)(sizeof ms_params / sizeof ms_params[0]),
+    .resources = ms_resources,
+    .aux = ms_aux,
+    .prepare = mssm_prepare,
+};
+
+const Technique tech_ysm = {
+    BP_TECHNIQUE,
+    .name = "ysm",
+    .source = "course §5.2.3.4-5 (YSM: HSM levels, then an MSSM; texel budget Fig. 5.11)",
+    .summary = "backprojection on the min-max pyramid's first n levels and an MSSM built on level n - 1: the "
+               "early outs of mssm at a quarter^(n-1) of its memory (aux class and level)",
+    .params = ysm_params,
+    .num_params = (int)(sizeof ysm_params / sizeof ysm_params[0]),
+    .resources = ms_resources,
+    .aux = ms_aux,
+    .prepare = ysm_prepare,
 };

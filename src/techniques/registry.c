@@ -30,6 +30,9 @@ extern const Technique tech_adaptive_area;
 extern const Technique tech_shadow_width;
 extern const Technique tech_aliasing;
 extern const Technique tech_backprojection;
+extern const Technique tech_hsm;
+extern const Technique tech_mssm;
+extern const Technique tech_ysm;
 extern const Technique tech_light_sampling;
 extern const Technique tech_occlusion_textures;
 extern const Technique tech_smrt;
@@ -66,6 +69,9 @@ static const Technique *const registry[] = {
     &tech_shadow_width,
     &tech_aliasing,
     &tech_backprojection,
+    &tech_hsm,
+    &tech_mssm,
+    &tech_ysm,
     &tech_light_sampling,
     &tech_occlusion_textures,
     &tech_smrt,

@@ -88,6 +88,12 @@ bool softmap_may_block(const SoftMap *sm, const SmapReceiver *r, int i0, int j0,
 {
     float zmin, zmax;
     minmax_query(sm->pyramid, r->mc.face, i0, j0, i1, j1, &zmin, &zmax);
+    return softmap_bounds_may_block(sm, r, zmin, i0, j0, i1, j1, z_min_linear);
+}
+
+bool softmap_bounds_may_block(const SoftMap *sm, const SmapReceiver *r, float zmin, int i0, int j0, int i1, int j1,
+                              double *z_min_linear)
+{
     if (z_min_linear) *z_min_linear = smap_linear_depth(sm->map, r->mc.face, zmin);
     double ref = nan_max(nan_max(smap_ref_at(r, i0, j0), smap_ref_at(r, i1, j0)),
                          nan_max(smap_ref_at(r, i0, j1), smap_ref_at(r, i1, j1)));

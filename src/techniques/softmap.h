@@ -62,6 +62,11 @@ bool softmap_frames(SoftMap *sm, const ShadowMap *map, const Light *light, const
  * window (world units), for searches that narrow through it. */
 bool softmap_may_block(const SoftMap *sm, const SmapReceiver *r, int i0, int j0, int i1, int j1,
                        double *z_min_linear);
+/* The same decision from a minimum `zmin` (stored depth) that some other
+ * min-max structure gives for that window (the multiscale maps of course
+ * §5.2.3.4). */
+bool softmap_bounds_may_block(const SoftMap *sm, const SmapReceiver *r, float zmin, int i0, int j0, int i1, int j1,
+                              double *z_min_linear);
 
 /* Linear depth (world units along the face's axis) of texel (i, j);
  * +INFINITY where no caster was drawn. */

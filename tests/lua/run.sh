@@ -276,6 +276,8 @@ run_repro() { # run_repro EXPERIMENT ARGS...: its output in $R/EXPERIMENT.log, i
     run_repro course-fig4.5-vsm-bleeding --map-size 128 $TINYQ
     run_repro fig3-7-aliasing-vs-z --map-size 256
     run_repro soft-failures --set camera.width=40 --set camera.height=30 --samples 16 --quiet --threads 1
+    run_repro course-fig5.10-5.11-multiscale --set camera.width=80 --set camera.height=60 --samples 16 --repeat 1 \
+        --warmup 0 --no-images --quiet --threads 1 # ~20 s on a loaded machine
 ) &
 lane=$!
 run_repro seed000-fig3 $TINYQ
@@ -293,8 +295,9 @@ run_repro exact-soft-vs-rays --quick 1 --set camera.width=48 --set camera.height
 wait "$lane"
 for e in seed000-fig3 seed001-adaptive-area seed002-single-sample seed003-shadow-width seed003-table1 \
          course-fig2.2-bias course-fig2.3-midpoint course-fig4.3-pcf-umbra course-fig4.5-vsm-bleeding \
-         course-fig4.7-csm-terms course-fig5.14-outer-penumbra fig3-7-aliasing-vs-z fig3-10-12-partitions \
-         fig3-13-storage-factor course-fig2.4-2.10-shadow-volumes exact-soft-vs-rays soft-failures; do
+         course-fig4.7-csm-terms course-fig5.10-5.11-multiscale course-fig5.14-outer-penumbra fig3-7-aliasing-vs-z \
+         fig3-10-12-partitions fig3-13-storage-factor course-fig2.4-2.10-shadow-volumes exact-soft-vs-rays \
+         soft-failures; do
     expect "${e}_reproduces" 0 "paper against measured" "reproduction:" -- \
         sh -c 'cat "$1.log"; exit "$(cat "$1.rc" 2>/dev/null || echo 1)"' sh "$R/$e"
 done
@@ -326,6 +329,8 @@ figure course_fig4_7_gibbs_overshoot "$R/course-fig4.7-csm-terms/reproduction.cs
 figure course_fig4_7_leak_ratio "$R/course-fig4.7-csm-terms/reproduction.csv" measured 0 10 quantity~"umbra leak"
 figure course_fig5_14_umbra_overestimated "$R/course-fig5.14-outer-penumbra/reproduction.csv" measured 1 10 \
     quantity~"umbra share" --hold
+figure course_fig5_10_mssm_classifies_better "$R/course-fig5.10-5.11-multiscale/reproduction.csv" measured 0.3 1 \
+    item~"mssm / hsm" --hold
 figure fig3_7_lispsm_product "$R/fig3-7-aliasing-vs-z/reproduction.csv" measured 95 103 \
     item~LiSPSM quantity~"max e_x x" --hold
 figure fig3_13_no_warping_behind "$R/fig3-13-storage-factor/reproduction.csv" measured 0.9 1.1 item~"behind: W" --hold

@@ -46,6 +46,7 @@ static const struct { const char *param, *settings; } probes[] = {
     {"split_3", "split_1=2 split_2=3"},
     {"cascade_select", "cascades=8"},
     {"cascade_blend", "cascades=8"},
+    {"blend", "budget=4"}, /* mssm, ysm: at 128^2 their narrow search areas fit budget 32 at level 0 */
 };
 
 /* The test's base values: the defaults, a small map, k's condition (when
