@@ -49,7 +49,8 @@ typedef struct SnapTri {
 typedef struct ThreadTris {
     SnapTri *tri;
     int count, cap;
-    int *tile_count; /* triangles of this thread per tile */
+    int *tile_count; /* triangles of this chunk per tile */
+    long entries;    /* bin entries of this chunk: the sum of tile_count */
     long culled, clipped;
 } ThreadTris;
 
@@ -162,6 +163,7 @@ struct RasterScratch {
     Block vertices, clip;               /* every mesh's, one after the other */
     Block tile_counts;                  /* chunks x tiles */
     Block bin_start, cursor, bins;      /* pass 3 */
+    Block block_sum;                    /* pass 3: one per thread */
     ThreadTris *chunk;                  /* per set-up chunk; push_tri grows its triangles */
     int num_chunks;
 };
@@ -170,7 +172,7 @@ void raster_scratch_free(RasterScratch *scratch)
 {
     if (!scratch) return;
     Block *blocks[] = {&scratch->vertices, &scratch->clip, &scratch->tile_counts, &scratch->bin_start,
-                       &scratch->cursor, &scratch->bins};
+                       &scratch->cursor, &scratch->bins, &scratch->block_sum};
     for (size_t i = 0; i < sizeof blocks / sizeof *blocks; i++) free(blocks[i]->p);
     for (int k = 0; k < scratch->num_chunks; k++) free(scratch->chunk[k].tri);
     free(scratch->chunk);
@@ -240,10 +242,11 @@ static bool texel_range(const Setup *s, SnapTri *t)
     return true;
 }
 
-static void count_tiles(const Setup *s, const SnapTri *t, int *tile_count)
+static void count_tiles(const Setup *s, const SnapTri *t, ThreadTris *tt)
 {
     for (int ty = t->j0 / TILE; ty <= t->j1 / TILE; ty++)
-        for (int tx = t->i0 / TILE; tx <= t->i1 / TILE; tx++) tile_count[ty * s->tiles_x + tx]++;
+        for (int tx = t->i0 / TILE; tx <= t->i1 / TILE; tx++) tt->tile_count[ty * s->tiles_x + tx]++;
+    tt->entries += (long)(t->j1 / TILE - t->j0 / TILE + 1) * (t->i1 / TILE - t->i0 / TILE + 1);
 }
 
 static int64_t area2(const int32_t *x, const int32_t *y, int a, int b, int c)
@@ -277,7 +280,7 @@ static bool emit_polygon(const Setup *s, const int32_t *x, const int32_t *y, con
         t.count = area > 0 ? count : -count;
         if (texel_range(s, &t)) {
             if (!push_tri(tt, &t)) return false;
-            count_tiles(s, &t, tt->tile_count);
+            count_tiles(s, &t, tt);
         }
     }
     return true;
@@ -612,68 +615,95 @@ static ValueMode value_mode(const RasterView *v, const RasterOptions *opt)
     return VALUE_PERSPECTIVE;
 }
 
-/* Pass 2 over this thread's chunk of the triangles of every mesh. */
+/* Pass 2 over one chunk of the triangles of every mesh, into a copy of the
+ * chunk's ThreadTris on this thread's stack: the chunks' records share cache
+ * lines, and two threads bumping neighbouring counts per triangle would pull
+ * the line back and forth (false sharing). */
 static bool setup_chunk(const Setup *s, const RasterMesh *meshes, int num_meshes, const Vertices *vx, long t0,
-                        long t1, ThreadTris *tt)
+                        long t1, ThreadTris *chunk)
 {
+    ThreadTris local = *chunk, *tt = &local;
+    bool ok = true;
     long base = 0;
-    for (int m = 0; m < num_meshes; m++) {
+    for (int m = 0; ok && m < num_meshes; m++) {
         long n = meshes[m].num_triangles;
         long lo = t0 > base ? t0 : base, hi = t1 < base + n ? t1 : base + n;
         const uint32_t *ix = meshes[m].indices;
-        for (long t = lo; t < hi; t++) {
+        for (long t = lo; ok && t < hi; t++) {
             if (t + PREFETCH_AHEAD < hi) {
                 const uint32_t *ahead = &ix[3 * (t + PREFETCH_AHEAD - base)];
                 for (int k = 0; k < 3; k++) __builtin_prefetch(&vx[m].v[ahead[k]]);
             }
             const int16_t *counts = s->opt->extra ? s->opt->extra[m].counts : NULL;
             int32_t count = counts ? counts[t - base] : 1;
-            if (!setup_triangle(s, &vx[m], &ix[3 * (t - base)], (int32_t)t, count, tt)) return false;
+            ok = setup_triangle(s, &vx[m], &ix[3 * (t - base)], (int32_t)t, count, tt);
         }
         base += n;
     }
-    return true;
+    *chunk = local;
+    return ok;
 }
 
-/* Passes 3 and 4: bins from the per-thread counts, then the tiles. */
+/* Pass 3's offsets, a parallel prefix sum over tiles x chunks, run by every
+ * thread of the region: bins are tile-major and in chunk order within a
+ * tile, so bin_start[tile] is where the tile's bin begins and
+ * cursor[k ntiles + tile] where chunk k's triangles of it go. Each thread
+ * sums a contiguous block of tiles, waits for the others, then offsets its
+ * block by the sums of the blocks before it (block_sum: one per thread). */
+static void bin_offsets(const ThreadTris *tt, int nchunks, int ntiles, int *bin_start, int *cursor, long *block_sum)
+{
+    int nt = omp_get_num_threads(), id = omp_get_thread_num();
+    int first = (int)((long)ntiles * id / nt), end = (int)((long)ntiles * (id + 1) / nt);
+    long sum = 0;
+    for (int tile = first; tile < end; tile++)
+        for (int k = 0; k < nchunks; k++) sum += tt[k].tile_count[tile];
+    block_sum[id] = sum;
+#pragma omp barrier
+    long at = 0;
+    for (int i = 0; i < id; i++) at += block_sum[i];
+    for (int tile = first; tile < end; tile++) {
+        bin_start[tile] = (int)at;
+        for (int k = 0; k < nchunks; k++) {
+            cursor[(size_t)k * ntiles + tile] = (int)at;
+            at += tt[k].tile_count[tile];
+        }
+    }
+    if (id == nt - 1) bin_start[ntiles] = (int)at;
+}
+
+/* Pass 3's scatter of one chunk's triangles into their tiles' bins. */
+static void bin_chunk(const Setup *s, const ThreadTris *tt, int *cursor, const SnapTri **bins)
+{
+    for (int i = 0; i < tt->count; i++) {
+        const SnapTri *t = &tt->tri[i];
+        for (int ty = t->j0 / TILE; ty <= t->j1 / TILE; ty++)
+            for (int tx = t->i0 / TILE; tx <= t->i1 / TILE; tx++) bins[cursor[ty * s->tiles_x + tx]++] = t;
+    }
+}
+
+/* Passes 3 and 4 in one parallel region (threads wait at its barriers, not
+ * at a fork per pass): bin offsets, the scatter per chunk, then the tiles. */
 static long bin_and_fill(const Setup *s, RasterScratch *sc, int nchunks, DepthBuffer *db, bool *ok, long *overflow)
 {
     ThreadTris *tt = sc->chunk;
     int ntiles = s->tiles_x * s->tiles_y;
-    long total = 0;
-    for (int k = 0; k < nchunks; k++)
-        for (int i = 0; i < tt[k].count; i++)
-            total += (long)(tt[k].tri[i].i1 / TILE - tt[k].tri[i].i0 / TILE + 1) *
-                     (tt[k].tri[i].j1 / TILE - tt[k].tri[i].j0 / TILE + 1);
+    long total = 0; /* bin entries, counted during set-up */
+    for (int k = 0; k < nchunks; k++) total += tt[k].entries;
     int *bin_start = block_reserve(&sc->bin_start, sizeof(int) * (size_t)(ntiles + 1));
     int *cursor = block_reserve(&sc->cursor, sizeof(int) * (size_t)ntiles * (size_t)nchunks);
+    long *block_sum = block_reserve(&sc->block_sum, sizeof(long) * (size_t)omp_get_max_threads());
     const SnapTri **bins = total < (long)1 << 31 ? block_reserve(&sc->bins, sizeof *bins * (size_t)total) : NULL;
-    *ok = bin_start && cursor && bins;
+    *ok = bin_start && cursor && block_sum && bins;
     if (!*ok) return 0;
-    int at = 0;
-    for (int tile = 0; tile < ntiles; tile++) { /* tile-major, thread order within a tile */
-        bin_start[tile] = at;
-        for (int k = 0; k < nchunks; k++) {
-            cursor[(size_t)k * ntiles + tile] = at;
-            at += tt[k].tile_count[tile];
-        }
-    }
-    bin_start[ntiles] = at;
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int k = 0; k < nchunks; k++) {
-        int *cur = cursor + (size_t)k * ntiles;
-        for (int i = 0; i < tt[k].count; i++) {
-            const SnapTri *t = &tt[k].tri[i];
-            for (int ty = t->j0 / TILE; ty <= t->j1 / TILE; ty++)
-                for (int tx = t->i0 / TILE; tx <= t->i1 / TILE; tx++) bins[cur[ty * s->tiles_x + tx]++] = t;
-        }
-    }
     long written = 0, refused = 0;
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : written, refused)
-    for (int tile = 0; tile < ntiles; tile++) {
-        long tile_refused = 0;
-        written += fill_tile(s, tile, bins, bin_start, db, &tile_refused);
-        refused += tile_refused;
+#pragma omp parallel reduction(+ : written, refused)
+    {
+        bin_offsets(tt, nchunks, ntiles, bin_start, cursor, block_sum);
+#pragma omp barrier
+#pragma omp for schedule(dynamic, 1)
+        for (int k = 0; k < nchunks; k++) bin_chunk(s, &tt[k], cursor + (size_t)k * ntiles, bins);
+#pragma omp for schedule(dynamic, 1)
+        for (int tile = 0; tile < ntiles; tile++) written += fill_tile(s, tile, bins, bin_start, db, &refused);
     }
     *overflow = refused;
     return written;
@@ -730,7 +760,7 @@ static bool scratch_prepare(RasterScratch *sc, const RasterMesh *meshes, int num
             t->cap = t->tri ? cap : 0;
             if (!t->tri) return false;
         }
-        *t = (ThreadTris){t->tri, 0, t->cap, counts + (size_t)k * ntiles, 0, 0};
+        *t = (ThreadTris){t->tri, 0, t->cap, counts + (size_t)k * ntiles, 0, 0, 0};
     }
     return true;
 }
