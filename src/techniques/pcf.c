@@ -180,21 +180,31 @@ static float filter_disk(const PcfState *st, const SmapReceiver *r, uint32_t sam
     return lit / (float)st->samples;
 }
 
+static float pcf_filter(const PcfState *st, const SmapReceiver *r, int sample)
+{
+    switch (st->kernel) {
+    case KERNEL_BOX: return filter_box(st, r);
+    case KERNEL_BILINEAR: return filter_bilinear(st, r);
+    default: return filter_disk(st, r, (uint32_t)sample);
+    }
+}
+
+/* Receivers are set up SMAP_BATCH samples at a time (smap_receivers), then
+ * filtered one by one. */
 static void pcf_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
 {
     const PcfState *st = state;
-    for (int s = begin; s < end; s++) {
-        if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
-        SmapReceiver r;
-        float v = 1.0f;
-        if (smap_receiver(st->map, &st->bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r)) {
-            switch (st->kernel) {
-            case KERNEL_BOX: v = filter_box(st, &r); break;
-            case KERNEL_BILINEAR: v = filter_bilinear(st, &r); break;
-            default: v = filter_disk(st, &r, (uint32_t)s); break;
-            }
+    for (int first = begin; first < end; first += SMAP_BATCH) {
+        int n = end - first < SMAP_BATCH ? end - first : SMAP_BATCH;
+        SmapReceiver r[SMAP_BATCH];
+        bool inside[SMAP_BATCH];
+        smap_receivers(st->map, &st->bias, ctx->vs->p_world + first, ctx->vs->n_geom_world + first, ctx->cls + first,
+                       n, r, inside);
+        for (int k = 0; k < n; k++) {
+            int s = first + k;
+            if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+            tech_store(ctx, out, begin, s, inside[k] ? pcf_filter(st, &r[k], s) : 1.0f);
         }
-        tech_store(ctx, out, begin, s, v);
     }
 }
 

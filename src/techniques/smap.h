@@ -188,6 +188,17 @@ typedef struct SmapReceiver {
  * should agree with `hard` wherever the surface faces the light squarely.
  * false when the sample falls outside the map (the technique decides: lit). */
 bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_geom_world, SmapReceiver *r);
+/* The same set-up for samples [0, count) of the arrays at once, those whose
+ * class is SAMPLE_LIT_CANDIDATE (cls NULL: all); inside[i] is what
+ * smap_receiver returns (false for the others, whose r[i] is not written).
+ * smap_receiver is a batch of one. On a plain projective map (one ortho or
+ * perspective face, no warp, cascades or cube) lifting, locating, the texel
+ * size and the depth slope run over SMAP_BATCH samples at a time in float32
+ * arrays, as a GPU's shader does; the biases then per receiver, in double.
+ * Other maps are located per sample in double (lightview_locate). */
+#define SMAP_BATCH 64
+void smap_receivers(const ShadowMap *m, const SmapBias *b, const vec3 *p_world, const vec3 *n_geom_world,
+                    const uint8_t *cls, int count, SmapReceiver *r, bool *inside);
 
 /* Reference depth to compare with texel (i, j) of the receiver's face. */
 static inline double smap_ref_at(const SmapReceiver *r, int i, int j)
