@@ -101,11 +101,12 @@ static bool pcf_prepare(const TechContext *ctx, void **state, Error *err)
 }
 
 /* Lit taps of row j (clamped to the edge, like shadowmap_texel) over
- * columns [i0, i0 + K) against one reference depth: smap_test with the row
- * addressed once and no per-tap branch, so the interior loop vectorises.
- * Lit and shadowed taps are counted apart: a NaN texel (or reference) is
- * neither, and makes the row NaN. */
-static float box_row_lit(const ShadowMap *m, int face, int i0, int j, int K, double ref)
+ * columns [i0, i0 + K) against one reference depth, rounded up to float32
+ * (smap_ref_up: the same outcomes as smap_test's double compare): smap_test
+ * with the row addressed once and no per-tap branch, in float lanes, so the
+ * interior loop vectorises. Lit and shadowed taps are counted apart: a NaN
+ * texel (or reference) is neither, and makes the row NaN. */
+static float box_row_lit(const ShadowMap *m, int face, int i0, int j, int K, float ref)
 {
     int res = m->res, jc = j < 0 ? 0 : j >= res ? res - 1 : j, lit = 0, shadowed = 0;
     const float *row = m->depth + ((size_t)face * (size_t)res + (size_t)jc) * (size_t)res;
@@ -133,7 +134,8 @@ static float filter_box(const PcfState *st, const SmapReceiver *r)
         for (int j = j0; j < j0 + st->K; j++)
             for (int i = i0; i < i0 + st->K; i++) lit += smap_lit(st->map, r, i, j);
     } else {
-        for (int j = j0; j < j0 + st->K; j++) lit += box_row_lit(st->map, r->mc.face, i0, j, st->K, r->ref);
+        float ref = smap_ref_up(r->ref);
+        for (int j = j0; j < j0 + st->K; j++) lit += box_row_lit(st->map, r->mc.face, i0, j, st->K, ref);
     }
     return lit / (float)(st->K * st->K);
 }

@@ -217,6 +217,16 @@ static inline float smap_test(double ref, double stored)
     return ref > stored ? 0.0f : ref <= stored ? 1.0f : NAN;
 }
 
+/* The smallest float32 at or above a reference depth: against any stored
+ * float32 z, ref <= z exactly when smap_ref_up(ref) <= z (and ref > z when
+ * it is > z; NaN stays NaN), so a filter may compare its taps in float
+ * lanes with smap_test's results unchanged. */
+static inline float smap_ref_up(double ref)
+{
+    float f = (float)ref;
+    return (double)f < ref ? nextafterf(f, INFINITY) : f;
+}
+
 static inline float smap_lit(const ShadowMap *m, const SmapReceiver *r, int i, int j)
 {
     return smap_test(smap_ref_at(r, i, j), shadowmap_texel(m, r->mc.face, i, j));

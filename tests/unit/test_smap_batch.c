@@ -104,3 +104,20 @@ TEST(test_smap_receivers_batch_locates_as_the_double_lookup)
     check_cases("scenes/sphere-on-plane.lua", perspective, 2);
     check_cases("scenes/overhead-plane.lua", ortho, 2);
 }
+
+/* smap_ref_up: a float compare gives the double compare's answer against
+ * every float32 near the reference (the float below, at and above it). */
+TEST(test_smap_ref_up_compares_as_the_double_reference)
+{
+    uint32_t state = 12345u;
+    long differing = 0, tried = 0;
+    for (int k = 0; k < 100000; k++) {
+        state = state * 1664525u + 1013904223u;
+        double ref = (state >> 8) / 16777216.0 + ldexp((double)(state & 0xff), -40); /* [0, 1), sub-float bits */
+        float z0 = (float)ref, zs[3] = {nextafterf(z0, -INFINITY), z0, nextafterf(z0, INFINITY)};
+        for (int i = 0; i < 3; i++, tried++)
+            differing += (ref <= zs[i]) != (smap_ref_up(ref) <= zs[i]) || (ref > zs[i]) != (smap_ref_up(ref) > zs[i]);
+    }
+    CHECK_MSG(differing == 0, "%ld of %ld float compares differ from the double compare", differing, tried);
+    CHECK_MSG(isnan(smap_ref_up(NAN)), "NaN reference became a value");
+}
