@@ -1,9 +1,10 @@
 /* raster.c -- the depth rasterizer of raster.h in four passes:
  *   1. vertices: world -> clip (or light view space for paraboloid maps);
- *   2. triangles (one static chunk per thread): cull, clip, snap to fixed
+ *   2. triangles (contiguous chunks, taken dynamically): cull, clip, snap to fixed
  *      point, orient counter-clockwise, fan into triangles, count per tile;
- *   3. binning: prefix sums give every tile a list of triangles in input
- *      order (chunks are contiguous, so the order is deterministic);
+ *   3. binning: a parallel prefix sum over tiles x chunks gives every tile
+ *      a list of triangles in input order (chunks are contiguous, so the
+ *      order is deterministic); passes 3 and 4 share one parallel region;
  *   4. tiles in parallel: per row, the exact span the three edge functions
  *      allow (integer arithmetic), then a vectorised depth loop over it (or,
  *      for the counting tests, a loop adding the triangle's signed count).
@@ -400,11 +401,14 @@ static inline int64_t floor_div_pos(int64_t n, int64_t d)
 
 /* Texels of row j inside the triangle, exactly: each edge E(i) = a (i SUB +
  * HALF) + r >= 0 bounds i from one side (a > 0: below, a < 0: above), in
- * integer arithmetic, so the span equals the per-texel edge tests. */
-static bool row_span(const Fill *F, int j, int *lo, int *hi)
+ * integer arithmetic, so the span equals the per-texel edge tests. Only the
+ * edges in the mask `edges` (bit k: edge k) are tested: the others hold over
+ * the whole box the caller fills (crossing_edges). */
+static bool row_span(const Fill *F, unsigned edges, int j, int *lo, int *hi)
 {
     int64_t py = (int64_t)j * SUB + HALF;
     for (int k = 0; k < 3; k++) {
+        if (!(edges >> k & 1u)) continue;
         int64_t a = F->a[k], r = F->b[k] * py + F->c[k], num = -r - a * HALF;
         if (a > 0) {
             int64_t m = -floor_div_pos(-num, a * SUB); /* ceil(num / den) */
@@ -498,12 +502,30 @@ static long fill_span(const Fill *F, const Target *T, const SnapTri *t, int j, i
     return written;
 }
 
+/* The edges that leave some texel centre of the box [i0, i1] x [j0, j1]
+ * outside (bit k: edge k). E is affine, so its least value over the box is
+ * at a corner: an edge inside at the four corner centres is inside over
+ * all of it, and row_span need not divide for it (a tile the triangle
+ * covers whole, like a ground plane's at large maps, needs none). */
+static unsigned crossing_edges(const Fill *F, int i0, int j0, int i1, int j1)
+{
+    int64_t x0 = (int64_t)i0 * SUB + HALF, x1 = (int64_t)i1 * SUB + HALF;
+    int64_t y0 = (int64_t)j0 * SUB + HALF, y1 = (int64_t)j1 * SUB + HALF;
+    unsigned edges = 0;
+    for (int k = 0; k < 3; k++) {
+        int64_t ex = F->a[k] * (F->a[k] < 0 ? x1 : x0), ey = F->b[k] * (F->b[k] < 0 ? y1 : y0);
+        if (ex + ey + F->c[k] < 0) edges |= 1u << k; /* the least corner value */
+    }
+    return edges;
+}
+
 static long fill_rect(const Fill *F, const Target *T, const SnapTri *t, int i0, int j0, int i1, int j1)
 {
+    unsigned edges = crossing_edges(F, i0, j0, i1, j1);
     long written = 0;
     for (int j = j0; j <= j1; j++) {
         int lo = i0, hi = i1;
-        if (row_span(F, j, &lo, &hi)) written += fill_span(F, T, t, j, lo, hi);
+        if (row_span(F, edges, j, &lo, &hi)) written += fill_span(F, T, t, j, lo, hi);
     }
     return written;
 }
