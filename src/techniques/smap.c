@@ -234,11 +234,16 @@ typedef struct BatchF {
 } BatchF;
 
 /* lightview_locate_on, lightview_texel_world and lightview_ndc_per_world of
- * an unwarped face for points [0, n) of the batch, in float32 lanes. */
-/* Without -ftrapping-math's promise that a comparison with NaN may trap
- * (no FP exception is ever unmasked here) GCC turns the selects into vector
- * blends; AVX2 where the CPU has it, 8 lanes. */
-__attribute__((optimize("no-trapping-math"), target_clones("avx2", "default")))
+ * an unwarped face for points [0, n) of the batch, in float32 lanes: AVX2
+ * where the CPU has it, 8 lanes. Without -ftrapping-math's promise that a
+ * comparison with NaN may trap (no FP exception is unmasked here) GCC
+ * turns the selects into vector blends. */
+#if defined(__clang__)
+#define NO_TRAPPING_MATH /* clang: no such attribute, nor the need */
+#else
+#define NO_TRAPPING_MATH __attribute__((optimize("no-trapping-math")))
+#endif
+NO_TRAPPING_MATH __attribute__((target_clones("avx2", "default")))
 static void locate_batch(const FaceF *f, int n, BatchF *b)
 {
     const float(*M)[4] = f->clip;
