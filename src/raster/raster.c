@@ -132,8 +132,9 @@ static int32_t snap(double texels, int size)
 /* A transformed vertex as the triangle pass reads it (32 bytes, so a mesh's
  * vertices stay in cache): the planes it is outside and, when inside all of
  * them, its snapped map position and values (computed once per vertex, so
- * shared vertices snap identically). Its clip coordinates live in a second
- * array that only triangles crossing a plane read. */
+ * shared vertices snap identically). Its clip coordinates are not stored:
+ * only triangles crossing a plane need them, and clip_vertex recomputes
+ * them there, the same arithmetic giving the same doubles. */
 #define OUTCODE_INVALID (1u << 6) /* inside, but no finite screen position */
 typedef struct RVertex {
     unsigned outcode;
@@ -143,8 +144,22 @@ typedef struct RVertex {
 
 typedef struct Vertices {
     RVertex *v;
-    ClipVertex *clip;
+    const RasterMesh *mesh;
+    const float *weights; /* RasterMeshExtra.weights, or NULL */
 } Vertices;
+
+/* Clip coordinates of vertex i of a mesh (for paraboloid maps light view
+ * space, front = -z: clip z = -z_view >= 0), with its linear depth. */
+static ClipVertex clip_vertex(const Setup *s, const Vertices *vx, uint32_t i)
+{
+    const RasterView *v = s->view;
+    const double *r = v->depth_row;
+    dvec3 p = d3_from(vx->mesh->positions[i]);
+    double h = vx->weights ? vx->weights[i] : 1.0; /* homogeneous (p, h) */
+    dvec4 c = m4_apply4(&v->clip_from_world, (dvec4){p.x, p.y, p.z, h});
+    if (v->mapping == RASTER_PARABOLOID) return (ClipVertex){c.x, c.y, -c.z, 1.0, 0.0};
+    return (ClipVertex){c.x, c.y, c.z, c.w, r[0] * p.x + r[1] * p.y + r[2] * p.z + r[3] * h};
+}
 
 /* ---- working memory kept between renders (DepthBuffer.scratch) ------------- */
 
@@ -161,7 +176,7 @@ static void *block_reserve(Block *b, size_t bytes)
 }
 
 struct RasterScratch {
-    Block vertices, clip;               /* every mesh's, one after the other */
+    Block vertices;                     /* every mesh's, one after the other */
     Block tile_counts;                  /* chunks x tiles */
     Block bin_start, cursor, bins;      /* pass 3 */
     Block block_sum;                    /* pass 3: one per thread */
@@ -172,7 +187,7 @@ struct RasterScratch {
 void raster_scratch_free(RasterScratch *scratch)
 {
     if (!scratch) return;
-    Block *blocks[] = {&scratch->vertices, &scratch->clip, &scratch->tile_counts, &scratch->bin_start,
+    Block *blocks[] = {&scratch->vertices, &scratch->tile_counts, &scratch->bin_start,
                        &scratch->cursor, &scratch->bins, &scratch->block_sum};
     for (size_t i = 0; i < sizeof blocks / sizeof *blocks; i++) free(blocks[i]->p);
     for (int k = 0; k < scratch->num_chunks; k++) free(scratch->chunk[k].tri);
@@ -180,27 +195,17 @@ void raster_scratch_free(RasterScratch *scratch)
     free(scratch);
 }
 
-static void transform_vertices(const Setup *s, const RasterMesh *m, const RasterMeshExtra *extra, Vertices *out)
+static void transform_vertices(const Setup *s, const Vertices *vx)
 {
-    const float *weights = extra ? extra->weights : NULL;
-    const RasterView *v = s->view;
-    const double *r = v->depth_row;
-    ClipPlanes planes = v->mapping == RASTER_PARABOLOID ? CLIP_FRONT_ONLY : CLIP_FRUSTUM;
+    ClipPlanes planes = s->view->mapping == RASTER_PARABOLOID ? CLIP_FRONT_ONLY : CLIP_FRUSTUM;
 #pragma omp parallel for schedule(dynamic, 2048)
-    for (int i = 0; i < m->num_vertices; i++) {
-        dvec3 p = d3_from(m->positions[i]);
-        double h = weights ? weights[i] : 1.0; /* homogeneous (p, h) */
-        dvec4 c = m4_apply4(&v->clip_from_world, (dvec4){p.x, p.y, p.z, h});
-        RVertex *o = &out->v[i];
-        ClipVertex *cv = &out->clip[i];
-        if (v->mapping == RASTER_PARABOLOID) /* light view space, front = -z: clip z = -z_view >= 0 */
-            *cv = (ClipVertex){c.x, c.y, -c.z, 1.0, 0.0};
-        else
-            *cv = (ClipVertex){c.x, c.y, c.z, c.w, r[0] * p.x + r[1] * p.y + r[2] * p.z + r[3] * h};
-        *o = (RVertex){clip_outcode(cv, planes), 0, 0, 0.0, 0.0};
+    for (int i = 0; i < vx->mesh->num_vertices; i++) {
+        ClipVertex cv = clip_vertex(s, vx, (uint32_t)i);
+        RVertex *o = &vx->v[i];
+        *o = (RVertex){clip_outcode(&cv, planes), 0, 0, 0.0, 0.0};
         ScreenVertex sv;
         if (o->outcode) continue;
-        if (!to_screen(s, cv, &sv)) { o->outcode = OUTCODE_INVALID; continue; }
+        if (!to_screen(s, &cv, &sv)) { o->outcode = OUTCODE_INVALID; continue; }
         o->x = snap(sv.sx, s->width);
         o->y = snap(sv.sy, s->height);
         o->f = sv.f;
@@ -288,10 +293,10 @@ static bool emit_polygon(const Setup *s, const int32_t *x, const int32_t *y, con
 }
 
 /* A triangle that crosses frustum planes: clip, project and snap its polygon. */
-static bool emit_clipped(const Setup *s, const ClipVertex *clip, const uint32_t *ix, unsigned crossing, int32_t id,
+static bool emit_clipped(const Setup *s, const Vertices *vx, const uint32_t *ix, unsigned crossing, int32_t id,
                          int32_t count, ThreadTris *tt, bool *culled)
 {
-    const ClipVertex tri[3] = {clip[ix[0]], clip[ix[1]], clip[ix[2]]};
+    const ClipVertex tri[3] = {clip_vertex(s, vx, ix[0]), clip_vertex(s, vx, ix[1]), clip_vertex(s, vx, ix[2])};
     ClipVertex poly[CLIP_MAX_VERTS];
     int n = clip_triangle(tri, crossing & ~OUTCODE_INVALID, poly);
     int32_t x[CLIP_MAX_VERTS], y[CLIP_MAX_VERTS];
@@ -318,7 +323,7 @@ static bool setup_triangle(const Setup *s, const Vertices *vx, const uint32_t *i
     bool ok;
     if (any) {
         tt->clipped++;
-        ok = emit_clipped(s, vx->clip, ix, any, id, count, tt, &culled);
+        ok = emit_clipped(s, vx, ix, any, id, count, tt, &culled);
     } else {
         const int32_t x[3] = {v[0]->x, v[1]->x, v[2]->x}, y[3] = {v[0]->y, v[1]->y, v[2]->y};
         const double f[3] = {v[0]->f, v[1]->f, v[2]->f}, q[3] = {v[0]->q, v[1]->q, v[2]->q};
@@ -759,12 +764,12 @@ static bool scratch_prepare(RasterScratch *sc, const RasterMesh *meshes, int num
     size_t nv = 0;
     for (int m = 0; m < num_meshes; m++) nv += (size_t)meshes[m].num_vertices;
     RVertex *v = block_reserve(&sc->vertices, sizeof *v * nv);
-    ClipVertex *clip = block_reserve(&sc->clip, sizeof *clip * nv);
     size_t ntiles = (size_t)s->tiles_x * (size_t)s->tiles_y;
     int *counts = block_reserve(&sc->tile_counts, sizeof(int) * ntiles * (size_t)nchunks);
-    if (!v || !clip || !counts) return false;
-    for (int m = 0; m < num_meshes; v += meshes[m].num_vertices, clip += meshes[m].num_vertices, m++)
-        cv[m] = (Vertices){v, clip};
+    if (!v || !counts) return false;
+    const RasterMeshExtra *extra = s->opt->extra;
+    for (int m = 0; m < num_meshes; v += meshes[m].num_vertices, m++)
+        cv[m] = (Vertices){v, &meshes[m], extra ? extra[m].weights : NULL};
     if (nchunks > sc->num_chunks) {
         ThreadTris *n = realloc(sc->chunk, sizeof *n * (size_t)nchunks);
         if (!n) return false;
@@ -806,7 +811,7 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
     Vertices *cv = calloc((size_t)(num_meshes > 0 ? num_meshes : 1), sizeof *cv);
     bool ok = db->scratch && cv && scratch_prepare(db->scratch, meshes, num_meshes, &s, nchunks, chunk, cv);
     ThreadTris *tt = ok ? db->scratch->chunk : NULL;
-    for (int m = 0; ok && m < num_meshes; m++) transform_vertices(&s, &meshes[m], opt->extra ? &opt->extra[m] : NULL, &cv[m]);
+    for (int m = 0; ok && m < num_meshes; m++) transform_vertices(&s, &cv[m]);
     if (ok) {
         int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : failed)
