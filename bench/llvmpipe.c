@@ -37,8 +37,8 @@
 #define DEPTH_TOLERANCE 1e-5 /* z_ndc: float32 transforms on one side, double on the other */
 
 #define DEPTH_HEADER                                                                                              \
-    "scene,triangles,res,llvmpipe_ms,shadowlab_ms,speedup,texels_covered,coverage_mismatch,depth_mismatch," \
-    "max_depth_diff,agree,renderer," BENCH_TAIL_HEADER "\n"
+    "scene,triangles,res,llvmpipe_ms,shadowlab_ms,speedup,fill_ms,vs_fill,texels_covered,coverage_mismatch,"    \
+    "depth_mismatch,max_depth_diff,agree,renderer," BENCH_TAIL_HEADER "\n"
 #define PCF_HEADER                                                                                              \
     "scene,width,height,map_res,K,candidates,llvmpipe_ms,shadowlab_ms,speedup,mae,samples_off,agree,renderer," \
     BENCH_TAIL_HEADER "\n"
@@ -148,6 +148,12 @@ typedef struct DepthRun {
     const RasterView *view;
     RasterOptions opt;
     DepthBuffer db;
+    /* The memory-write limit, timed in the same rounds: the map's bytes
+     * stored once by the same threads (fill), and per round shadowlab's
+     * time over it; round 0 is the warm-up. */
+    float *fill;
+    double *fill_s, *vs_fill;
+    int rounds, max_rounds;
 } DepthRun;
 
 static void gl_depth_draw(void *arg)
@@ -197,9 +203,24 @@ static bool depth_agrees(const DepthAgreement *a)
     return a->coverage_mismatch / n < 1e-3 && a->depth_mismatch / n < 1e-3;
 }
 
+/* Every texel of a map stored once (the empty value, +INFINITY) by the
+ * OpenMP threads, in the static split the compiler turns into vector
+ * stores: what writing the map's bytes costs at the least. */
+static double fill_timed(float *d, size_t n)
+{
+    double t0 = timer_now_s();
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) d[i] = INFINITY;
+    double s = timer_now_s() - t0;
+    volatile float keep = d[n / 2]; /* the stores are read: not dead */
+    (void)keep;
+    return s;
+}
+
 /* One round: each side draws twice back to back and the second draw is
  * timed, so both run with warm caches and awake threads rather than
- * inheriting the other's cache state and sleeping worker pool. */
+ * inheriting the other's cache state and sleeping worker pool; then the
+ * fill of the map's bytes, the same way. */
 static bool depth_round(void *run, double *gl_s, double *ours_s, Error *err)
 {
     DepthRun *r = run;
@@ -211,25 +232,33 @@ static bool depth_round(void *run, double *gl_s, double *ours_s, Error *err)
         ok = raster_depth(r->c->mesh, r->c->num_meshes, r->view, &r->opt, &r->db, &st, err);
         *ours_s = timer_now_s() - t0;
     }
+    double fill_s = 0.0;
+    for (int k = 0; k < 2; k++) fill_s = fill_timed(r->fill, (size_t)r->db.width * r->db.height);
+    if (r->rounds < r->max_rounds) {
+        r->fill_s[r->rounds] = fill_s;
+        r->vs_fill[r->rounds] = fill_s > 0.0 ? *ours_s / fill_s : INFINITY;
+        r->rounds++;
+    }
     return ok && gl_check("the depth pass", err);
 }
 
-static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c, int res, const double med[3],
+/* med: llvmpipe s, shadowlab s, their ratio; fill s, shadowlab / fill. */
+static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c, int res, const double med[5],
                             const DepthAgreement *a, const char *renderer, Error *err)
 {
     char row[2048], tail[512], name[160], rend[300];
     bench_tail(tail, sizeof tail, o->c.threads);
     bench_csv_field(name, sizeof name, sc->name);
     bench_csv_field(rend, sizeof rend, renderer);
-    snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%ld,%ld,%ld,%.3g,%s,%s,%s\n", name, c->triangles, res,
-             med[0] * 1e3, med[1] * 1e3, med[2], a->covered, a->coverage_mismatch, a->depth_mismatch, a->max_diff,
-             depth_agrees(a) ? "yes" : "no", rend, tail);
+    snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%ld,%ld,%ld,%.3g,%s,%s,%s\n", name, c->triangles,
+             res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[4], a->covered, a->coverage_mismatch,
+             a->depth_mismatch, a->max_diff, depth_agrees(a) ? "yes" : "no", rend, tail);
     char path[4096];
     snprintf(path, sizeof path, "%s/llvmpipe_depth.csv", o->c.dir);
-    printf("  depth %5d^2: llvmpipe %8.2f ms, shadowlab %8.2f ms, speed-up %.2fx; coverage off %ld, depth off %ld of "
-           "%ld (max %.2g)%s\n",
-           res, med[0] * 1e3, med[1] * 1e3, med[2], a->coverage_mismatch, a->depth_mismatch, a->covered, a->max_diff,
-           depth_agrees(a) ? "" : "  MISMATCH");
+    printf("  depth %5d^2: llvmpipe %8.2f ms, shadowlab %8.2f ms, speed-up %.2fx; fill %.2f ms, shadowlab / fill "
+           "%.2f; coverage off %ld, depth off %ld of %ld (max %.2g)%s\n",
+           res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[4], a->coverage_mismatch, a->depth_mismatch,
+           a->covered, a->max_diff, depth_agrees(a) ? "" : "  MISMATCH");
     return bench_csv_append(path, DEPTH_HEADER, row, err);
 }
 
@@ -237,15 +266,21 @@ static bool bench_depth(Lab *lab, const Casters *c, const GlContext *gl, const O
 {
     const ShadowMap *map = bench_map(lab, res, err);
     if (!map) return false;
-    DepthRun r = {c, NULL, &map->view.face[0].raster, {.depth = RASTER_DEPTH_NDC}, {0}};
+    DepthRun r = {c, NULL, &map->view.face[0].raster, {.depth = RASTER_DEPTH_NDC}, {0}, NULL, NULL, NULL, 0,
+                  o->c.repeat + 1};
     GlTarget target;
     if (!gl_target_init(&target, res, res, GL_DEPTH_COMPONENT32F, err)) return false;
     r.target = &target;
     float *gl_depth = malloc(sizeof *gl_depth * (size_t)res * res);
-    double med[3];
-    bool ok = gl_depth && depth_buffer_init(&r.db, res, res, false, err) &&
-              bench_paired(depth_round, &r, o->c.repeat, med, err);
+    r.fill = malloc(sizeof *r.fill * (size_t)res * res);
+    r.fill_s = malloc(sizeof *r.fill_s * (size_t)r.max_rounds);
+    r.vs_fill = malloc(sizeof *r.vs_fill * (size_t)r.max_rounds);
+    double med[5];
+    bool ok = (gl_depth && r.fill && r.fill_s && r.vs_fill) || error_set(err, "out of memory");
+    ok = ok && depth_buffer_init(&r.db, res, res, false, err) && bench_paired(depth_round, &r, o->c.repeat, med, err);
     if (ok) {
+        med[3] = r.rounds > 1 ? bench_median(r.fill_s + 1, r.rounds - 1) : NAN; /* round 0: the warm-up */
+        med[4] = r.rounds > 1 ? bench_median(r.vs_fill + 1, r.rounds - 1) : NAN;
         glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
         glPixelStorei(GL_PACK_ALIGNMENT, 4);
         glReadPixels(0, 0, res, res, GL_DEPTH_COMPONENT, GL_FLOAT, gl_depth);
@@ -254,6 +289,9 @@ static bool bench_depth(Lab *lab, const Casters *c, const GlContext *gl, const O
              write_depth_row(o, lab_scene(lab), c, res, med, &a, gl_context_renderer(gl), err);
     }
     free(gl_depth);
+    free(r.fill);
+    free(r.fill_s);
+    free(r.vs_fill);
     depth_buffer_free(&r.db);
     gl_target_free(&target);
     return ok;

@@ -1,9 +1,10 @@
 /* raster.c -- the depth rasterizer of raster.h in four passes:
  *   1. vertices: world -> clip (or light view space for paraboloid maps);
- *   2. triangles (one static chunk per thread): cull, clip, snap to fixed
+ *   2. triangles (contiguous chunks, taken dynamically): cull, clip, snap to fixed
  *      point, orient counter-clockwise, fan into triangles, count per tile;
- *   3. binning: prefix sums give every tile a list of triangles in input
- *      order (chunks are contiguous, so the order is deterministic);
+ *   3. binning: a parallel prefix sum over tiles x chunks gives every tile
+ *      a list of triangles in input order (chunks are contiguous, so the
+ *      order is deterministic); passes 3 and 4 share one parallel region;
  *   4. tiles in parallel: per row, the exact span the three edge functions
  *      allow (integer arithmetic), then a vectorised depth loop over it (or,
  *      for the counting tests, a loop adding the triangle's signed count).
@@ -49,7 +50,8 @@ typedef struct SnapTri {
 typedef struct ThreadTris {
     SnapTri *tri;
     int count, cap;
-    int *tile_count; /* triangles of this thread per tile */
+    int *tile_count; /* triangles of this chunk per tile */
+    long entries;    /* bin entries of this chunk: the sum of tile_count */
     long culled, clipped;
 } ThreadTris;
 
@@ -130,8 +132,9 @@ static int32_t snap(double texels, int size)
 /* A transformed vertex as the triangle pass reads it (32 bytes, so a mesh's
  * vertices stay in cache): the planes it is outside and, when inside all of
  * them, its snapped map position and values (computed once per vertex, so
- * shared vertices snap identically). Its clip coordinates live in a second
- * array that only triangles crossing a plane read. */
+ * shared vertices snap identically). Its clip coordinates are not stored:
+ * only triangles crossing a plane need them, and clip_vertex recomputes
+ * them there, the same arithmetic giving the same doubles. */
 #define OUTCODE_INVALID (1u << 6) /* inside, but no finite screen position */
 typedef struct RVertex {
     unsigned outcode;
@@ -141,8 +144,22 @@ typedef struct RVertex {
 
 typedef struct Vertices {
     RVertex *v;
-    ClipVertex *clip;
+    const RasterMesh *mesh;
+    const float *weights; /* RasterMeshExtra.weights, or NULL */
 } Vertices;
+
+/* Clip coordinates of vertex i of a mesh (for paraboloid maps light view
+ * space, front = -z: clip z = -z_view >= 0), with its linear depth. */
+static ClipVertex clip_vertex(const Setup *s, const Vertices *vx, uint32_t i)
+{
+    const RasterView *v = s->view;
+    const double *r = v->depth_row;
+    dvec3 p = d3_from(vx->mesh->positions[i]);
+    double h = vx->weights ? vx->weights[i] : 1.0; /* homogeneous (p, h) */
+    dvec4 c = m4_apply4(&v->clip_from_world, (dvec4){p.x, p.y, p.z, h});
+    if (v->mapping == RASTER_PARABOLOID) return (ClipVertex){c.x, c.y, -c.z, 1.0, 0.0};
+    return (ClipVertex){c.x, c.y, c.z, c.w, r[0] * p.x + r[1] * p.y + r[2] * p.z + r[3] * h};
+}
 
 /* ---- working memory kept between renders (DepthBuffer.scratch) ------------- */
 
@@ -159,9 +176,10 @@ static void *block_reserve(Block *b, size_t bytes)
 }
 
 struct RasterScratch {
-    Block vertices, clip;               /* every mesh's, one after the other */
+    Block vertices;                     /* every mesh's, one after the other */
     Block tile_counts;                  /* chunks x tiles */
     Block bin_start, cursor, bins;      /* pass 3 */
+    Block block_sum;                    /* pass 3: one per thread */
     ThreadTris *chunk;                  /* per set-up chunk; push_tri grows its triangles */
     int num_chunks;
 };
@@ -169,35 +187,25 @@ struct RasterScratch {
 void raster_scratch_free(RasterScratch *scratch)
 {
     if (!scratch) return;
-    Block *blocks[] = {&scratch->vertices, &scratch->clip, &scratch->tile_counts, &scratch->bin_start,
-                       &scratch->cursor, &scratch->bins};
+    Block *blocks[] = {&scratch->vertices, &scratch->tile_counts, &scratch->bin_start,
+                       &scratch->cursor, &scratch->bins, &scratch->block_sum};
     for (size_t i = 0; i < sizeof blocks / sizeof *blocks; i++) free(blocks[i]->p);
     for (int k = 0; k < scratch->num_chunks; k++) free(scratch->chunk[k].tri);
     free(scratch->chunk);
     free(scratch);
 }
 
-static void transform_vertices(const Setup *s, const RasterMesh *m, const RasterMeshExtra *extra, Vertices *out)
+static void transform_vertices(const Setup *s, const Vertices *vx)
 {
-    const float *weights = extra ? extra->weights : NULL;
-    const RasterView *v = s->view;
-    const double *r = v->depth_row;
-    ClipPlanes planes = v->mapping == RASTER_PARABOLOID ? CLIP_FRONT_ONLY : CLIP_FRUSTUM;
+    ClipPlanes planes = s->view->mapping == RASTER_PARABOLOID ? CLIP_FRONT_ONLY : CLIP_FRUSTUM;
 #pragma omp parallel for schedule(dynamic, 2048)
-    for (int i = 0; i < m->num_vertices; i++) {
-        dvec3 p = d3_from(m->positions[i]);
-        double h = weights ? weights[i] : 1.0; /* homogeneous (p, h) */
-        dvec4 c = m4_apply4(&v->clip_from_world, (dvec4){p.x, p.y, p.z, h});
-        RVertex *o = &out->v[i];
-        ClipVertex *cv = &out->clip[i];
-        if (v->mapping == RASTER_PARABOLOID) /* light view space, front = -z: clip z = -z_view >= 0 */
-            *cv = (ClipVertex){c.x, c.y, -c.z, 1.0, 0.0};
-        else
-            *cv = (ClipVertex){c.x, c.y, c.z, c.w, r[0] * p.x + r[1] * p.y + r[2] * p.z + r[3] * h};
-        *o = (RVertex){clip_outcode(cv, planes), 0, 0, 0.0, 0.0};
+    for (int i = 0; i < vx->mesh->num_vertices; i++) {
+        ClipVertex cv = clip_vertex(s, vx, (uint32_t)i);
+        RVertex *o = &vx->v[i];
+        *o = (RVertex){clip_outcode(&cv, planes), 0, 0, 0.0, 0.0};
         ScreenVertex sv;
         if (o->outcode) continue;
-        if (!to_screen(s, cv, &sv)) { o->outcode = OUTCODE_INVALID; continue; }
+        if (!to_screen(s, &cv, &sv)) { o->outcode = OUTCODE_INVALID; continue; }
         o->x = snap(sv.sx, s->width);
         o->y = snap(sv.sy, s->height);
         o->f = sv.f;
@@ -240,10 +248,11 @@ static bool texel_range(const Setup *s, SnapTri *t)
     return true;
 }
 
-static void count_tiles(const Setup *s, const SnapTri *t, int *tile_count)
+static void count_tiles(const Setup *s, const SnapTri *t, ThreadTris *tt)
 {
     for (int ty = t->j0 / TILE; ty <= t->j1 / TILE; ty++)
-        for (int tx = t->i0 / TILE; tx <= t->i1 / TILE; tx++) tile_count[ty * s->tiles_x + tx]++;
+        for (int tx = t->i0 / TILE; tx <= t->i1 / TILE; tx++) tt->tile_count[ty * s->tiles_x + tx]++;
+    tt->entries += (long)(t->j1 / TILE - t->j0 / TILE + 1) * (t->i1 / TILE - t->i0 / TILE + 1);
 }
 
 static int64_t area2(const int32_t *x, const int32_t *y, int a, int b, int c)
@@ -277,17 +286,17 @@ static bool emit_polygon(const Setup *s, const int32_t *x, const int32_t *y, con
         t.count = area > 0 ? count : -count;
         if (texel_range(s, &t)) {
             if (!push_tri(tt, &t)) return false;
-            count_tiles(s, &t, tt->tile_count);
+            count_tiles(s, &t, tt);
         }
     }
     return true;
 }
 
 /* A triangle that crosses frustum planes: clip, project and snap its polygon. */
-static bool emit_clipped(const Setup *s, const ClipVertex *clip, const uint32_t *ix, unsigned crossing, int32_t id,
+static bool emit_clipped(const Setup *s, const Vertices *vx, const uint32_t *ix, unsigned crossing, int32_t id,
                          int32_t count, ThreadTris *tt, bool *culled)
 {
-    const ClipVertex tri[3] = {clip[ix[0]], clip[ix[1]], clip[ix[2]]};
+    const ClipVertex tri[3] = {clip_vertex(s, vx, ix[0]), clip_vertex(s, vx, ix[1]), clip_vertex(s, vx, ix[2])};
     ClipVertex poly[CLIP_MAX_VERTS];
     int n = clip_triangle(tri, crossing & ~OUTCODE_INVALID, poly);
     int32_t x[CLIP_MAX_VERTS], y[CLIP_MAX_VERTS];
@@ -314,7 +323,7 @@ static bool setup_triangle(const Setup *s, const Vertices *vx, const uint32_t *i
     bool ok;
     if (any) {
         tt->clipped++;
-        ok = emit_clipped(s, vx->clip, ix, any, id, count, tt, &culled);
+        ok = emit_clipped(s, vx, ix, any, id, count, tt, &culled);
     } else {
         const int32_t x[3] = {v[0]->x, v[1]->x, v[2]->x}, y[3] = {v[0]->y, v[1]->y, v[2]->y};
         const double f[3] = {v[0]->f, v[1]->f, v[2]->f}, q[3] = {v[0]->q, v[1]->q, v[2]->q};
@@ -397,11 +406,14 @@ static inline int64_t floor_div_pos(int64_t n, int64_t d)
 
 /* Texels of row j inside the triangle, exactly: each edge E(i) = a (i SUB +
  * HALF) + r >= 0 bounds i from one side (a > 0: below, a < 0: above), in
- * integer arithmetic, so the span equals the per-texel edge tests. */
-static bool row_span(const Fill *F, int j, int *lo, int *hi)
+ * integer arithmetic, so the span equals the per-texel edge tests. Only the
+ * edges in the mask `edges` (bit k: edge k) are tested: the others hold over
+ * the whole box the caller fills (crossing_edges). */
+static bool row_span(const Fill *F, unsigned edges, int j, int *lo, int *hi)
 {
     int64_t py = (int64_t)j * SUB + HALF;
     for (int k = 0; k < 3; k++) {
+        if (!(edges >> k & 1u)) continue;
         int64_t a = F->a[k], r = F->b[k] * py + F->c[k], num = -r - a * HALF;
         if (a > 0) {
             int64_t m = -floor_div_pos(-num, a * SUB); /* ceil(num / den) */
@@ -495,12 +507,30 @@ static long fill_span(const Fill *F, const Target *T, const SnapTri *t, int j, i
     return written;
 }
 
+/* The edges that leave some texel centre of the box [i0, i1] x [j0, j1]
+ * outside (bit k: edge k). E is affine, so its least value over the box is
+ * at a corner: an edge inside at the four corner centres is inside over
+ * all of it, and row_span need not divide for it (a tile the triangle
+ * covers whole, like a ground plane's at large maps, needs none). */
+static unsigned crossing_edges(const Fill *F, int i0, int j0, int i1, int j1)
+{
+    int64_t x0 = (int64_t)i0 * SUB + HALF, x1 = (int64_t)i1 * SUB + HALF;
+    int64_t y0 = (int64_t)j0 * SUB + HALF, y1 = (int64_t)j1 * SUB + HALF;
+    unsigned edges = 0;
+    for (int k = 0; k < 3; k++) {
+        int64_t ex = F->a[k] * (F->a[k] < 0 ? x1 : x0), ey = F->b[k] * (F->b[k] < 0 ? y1 : y0);
+        if (ex + ey + F->c[k] < 0) edges |= 1u << k; /* the least corner value */
+    }
+    return edges;
+}
+
 static long fill_rect(const Fill *F, const Target *T, const SnapTri *t, int i0, int j0, int i1, int j1)
 {
+    unsigned edges = crossing_edges(F, i0, j0, i1, j1);
     long written = 0;
     for (int j = j0; j <= j1; j++) {
         int lo = i0, hi = i1;
-        if (row_span(F, j, &lo, &hi)) written += fill_span(F, T, t, j, lo, hi);
+        if (row_span(F, edges, j, &lo, &hi)) written += fill_span(F, T, t, j, lo, hi);
     }
     return written;
 }
@@ -612,68 +642,95 @@ static ValueMode value_mode(const RasterView *v, const RasterOptions *opt)
     return VALUE_PERSPECTIVE;
 }
 
-/* Pass 2 over this thread's chunk of the triangles of every mesh. */
+/* Pass 2 over one chunk of the triangles of every mesh, into a copy of the
+ * chunk's ThreadTris on this thread's stack: the chunks' records share cache
+ * lines, and two threads bumping neighbouring counts per triangle would pull
+ * the line back and forth (false sharing). */
 static bool setup_chunk(const Setup *s, const RasterMesh *meshes, int num_meshes, const Vertices *vx, long t0,
-                        long t1, ThreadTris *tt)
+                        long t1, ThreadTris *chunk)
 {
+    ThreadTris local = *chunk, *tt = &local;
+    bool ok = true;
     long base = 0;
-    for (int m = 0; m < num_meshes; m++) {
+    for (int m = 0; ok && m < num_meshes; m++) {
         long n = meshes[m].num_triangles;
         long lo = t0 > base ? t0 : base, hi = t1 < base + n ? t1 : base + n;
         const uint32_t *ix = meshes[m].indices;
-        for (long t = lo; t < hi; t++) {
+        for (long t = lo; ok && t < hi; t++) {
             if (t + PREFETCH_AHEAD < hi) {
                 const uint32_t *ahead = &ix[3 * (t + PREFETCH_AHEAD - base)];
                 for (int k = 0; k < 3; k++) __builtin_prefetch(&vx[m].v[ahead[k]]);
             }
             const int16_t *counts = s->opt->extra ? s->opt->extra[m].counts : NULL;
             int32_t count = counts ? counts[t - base] : 1;
-            if (!setup_triangle(s, &vx[m], &ix[3 * (t - base)], (int32_t)t, count, tt)) return false;
+            ok = setup_triangle(s, &vx[m], &ix[3 * (t - base)], (int32_t)t, count, tt);
         }
         base += n;
     }
-    return true;
+    *chunk = local;
+    return ok;
 }
 
-/* Passes 3 and 4: bins from the per-thread counts, then the tiles. */
+/* Pass 3's offsets, a parallel prefix sum over tiles x chunks, run by every
+ * thread of the region: bins are tile-major and in chunk order within a
+ * tile, so bin_start[tile] is where the tile's bin begins and
+ * cursor[k ntiles + tile] where chunk k's triangles of it go. Each thread
+ * sums a contiguous block of tiles, waits for the others, then offsets its
+ * block by the sums of the blocks before it (block_sum: one per thread). */
+static void bin_offsets(const ThreadTris *tt, int nchunks, int ntiles, int *bin_start, int *cursor, long *block_sum)
+{
+    int nt = omp_get_num_threads(), id = omp_get_thread_num();
+    int first = (int)((long)ntiles * id / nt), end = (int)((long)ntiles * (id + 1) / nt);
+    long sum = 0;
+    for (int tile = first; tile < end; tile++)
+        for (int k = 0; k < nchunks; k++) sum += tt[k].tile_count[tile];
+    block_sum[id] = sum;
+#pragma omp barrier
+    long at = 0;
+    for (int i = 0; i < id; i++) at += block_sum[i];
+    for (int tile = first; tile < end; tile++) {
+        bin_start[tile] = (int)at;
+        for (int k = 0; k < nchunks; k++) {
+            cursor[(size_t)k * ntiles + tile] = (int)at;
+            at += tt[k].tile_count[tile];
+        }
+    }
+    if (id == nt - 1) bin_start[ntiles] = (int)at;
+}
+
+/* Pass 3's scatter of one chunk's triangles into their tiles' bins. */
+static void bin_chunk(const Setup *s, const ThreadTris *tt, int *cursor, const SnapTri **bins)
+{
+    for (int i = 0; i < tt->count; i++) {
+        const SnapTri *t = &tt->tri[i];
+        for (int ty = t->j0 / TILE; ty <= t->j1 / TILE; ty++)
+            for (int tx = t->i0 / TILE; tx <= t->i1 / TILE; tx++) bins[cursor[ty * s->tiles_x + tx]++] = t;
+    }
+}
+
+/* Passes 3 and 4 in one parallel region (threads wait at its barriers, not
+ * at a fork per pass): bin offsets, the scatter per chunk, then the tiles. */
 static long bin_and_fill(const Setup *s, RasterScratch *sc, int nchunks, DepthBuffer *db, bool *ok, long *overflow)
 {
     ThreadTris *tt = sc->chunk;
     int ntiles = s->tiles_x * s->tiles_y;
-    long total = 0;
-    for (int k = 0; k < nchunks; k++)
-        for (int i = 0; i < tt[k].count; i++)
-            total += (long)(tt[k].tri[i].i1 / TILE - tt[k].tri[i].i0 / TILE + 1) *
-                     (tt[k].tri[i].j1 / TILE - tt[k].tri[i].j0 / TILE + 1);
+    long total = 0; /* bin entries, counted during set-up */
+    for (int k = 0; k < nchunks; k++) total += tt[k].entries;
     int *bin_start = block_reserve(&sc->bin_start, sizeof(int) * (size_t)(ntiles + 1));
     int *cursor = block_reserve(&sc->cursor, sizeof(int) * (size_t)ntiles * (size_t)nchunks);
+    long *block_sum = block_reserve(&sc->block_sum, sizeof(long) * (size_t)omp_get_max_threads());
     const SnapTri **bins = total < (long)1 << 31 ? block_reserve(&sc->bins, sizeof *bins * (size_t)total) : NULL;
-    *ok = bin_start && cursor && bins;
+    *ok = bin_start && cursor && block_sum && bins;
     if (!*ok) return 0;
-    int at = 0;
-    for (int tile = 0; tile < ntiles; tile++) { /* tile-major, thread order within a tile */
-        bin_start[tile] = at;
-        for (int k = 0; k < nchunks; k++) {
-            cursor[(size_t)k * ntiles + tile] = at;
-            at += tt[k].tile_count[tile];
-        }
-    }
-    bin_start[ntiles] = at;
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int k = 0; k < nchunks; k++) {
-        int *cur = cursor + (size_t)k * ntiles;
-        for (int i = 0; i < tt[k].count; i++) {
-            const SnapTri *t = &tt[k].tri[i];
-            for (int ty = t->j0 / TILE; ty <= t->j1 / TILE; ty++)
-                for (int tx = t->i0 / TILE; tx <= t->i1 / TILE; tx++) bins[cur[ty * s->tiles_x + tx]++] = t;
-        }
-    }
     long written = 0, refused = 0;
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : written, refused)
-    for (int tile = 0; tile < ntiles; tile++) {
-        long tile_refused = 0;
-        written += fill_tile(s, tile, bins, bin_start, db, &tile_refused);
-        refused += tile_refused;
+#pragma omp parallel reduction(+ : written, refused)
+    {
+        bin_offsets(tt, nchunks, ntiles, bin_start, cursor, block_sum);
+#pragma omp barrier
+#pragma omp for schedule(dynamic, 1)
+        for (int k = 0; k < nchunks; k++) bin_chunk(s, &tt[k], cursor + (size_t)k * ntiles, bins);
+#pragma omp for schedule(dynamic, 1)
+        for (int tile = 0; tile < ntiles; tile++) written += fill_tile(s, tile, bins, bin_start, db, &refused);
     }
     *overflow = refused;
     return written;
@@ -707,12 +764,12 @@ static bool scratch_prepare(RasterScratch *sc, const RasterMesh *meshes, int num
     size_t nv = 0;
     for (int m = 0; m < num_meshes; m++) nv += (size_t)meshes[m].num_vertices;
     RVertex *v = block_reserve(&sc->vertices, sizeof *v * nv);
-    ClipVertex *clip = block_reserve(&sc->clip, sizeof *clip * nv);
     size_t ntiles = (size_t)s->tiles_x * (size_t)s->tiles_y;
     int *counts = block_reserve(&sc->tile_counts, sizeof(int) * ntiles * (size_t)nchunks);
-    if (!v || !clip || !counts) return false;
-    for (int m = 0; m < num_meshes; v += meshes[m].num_vertices, clip += meshes[m].num_vertices, m++)
-        cv[m] = (Vertices){v, clip};
+    if (!v || !counts) return false;
+    const RasterMeshExtra *extra = s->opt->extra;
+    for (int m = 0; m < num_meshes; v += meshes[m].num_vertices, m++)
+        cv[m] = (Vertices){v, &meshes[m], extra ? extra[m].weights : NULL};
     if (nchunks > sc->num_chunks) {
         ThreadTris *n = realloc(sc->chunk, sizeof *n * (size_t)nchunks);
         if (!n) return false;
@@ -730,7 +787,7 @@ static bool scratch_prepare(RasterScratch *sc, const RasterMesh *meshes, int num
             t->cap = t->tri ? cap : 0;
             if (!t->tri) return false;
         }
-        *t = (ThreadTris){t->tri, 0, t->cap, counts + (size_t)k * ntiles, 0, 0};
+        *t = (ThreadTris){t->tri, 0, t->cap, counts + (size_t)k * ntiles, 0, 0, 0};
     }
     return true;
 }
@@ -754,7 +811,7 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
     Vertices *cv = calloc((size_t)(num_meshes > 0 ? num_meshes : 1), sizeof *cv);
     bool ok = db->scratch && cv && scratch_prepare(db->scratch, meshes, num_meshes, &s, nchunks, chunk, cv);
     ThreadTris *tt = ok ? db->scratch->chunk : NULL;
-    for (int m = 0; ok && m < num_meshes; m++) transform_vertices(&s, &meshes[m], opt->extra ? &opt->extra[m] : NULL, &cv[m]);
+    for (int m = 0; ok && m < num_meshes; m++) transform_vertices(&s, &cv[m]);
     if (ok) {
         int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : failed)

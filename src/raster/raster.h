@@ -102,7 +102,7 @@ typedef struct DepthBuffer {
     float *depth;
     int32_t *triangle;
     /* Working memory raster_depth keeps between renders into this buffer
-     * (transformed vertices, set-up triangles, tile bins: about 150 bytes
+     * (transformed vertices, set-up triangles, tile bins: about 130 bytes
      * per triangle), so a sweep or a cube map's faces do not fault fresh
      * pages in at every render. NULL until the first render; released by
      * depth_buffer_free, or by raster_scratch_free for buffers whose depth

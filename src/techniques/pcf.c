@@ -101,11 +101,12 @@ static bool pcf_prepare(const TechContext *ctx, void **state, Error *err)
 }
 
 /* Lit taps of row j (clamped to the edge, like shadowmap_texel) over
- * columns [i0, i0 + K) against one reference depth: smap_test with the row
- * addressed once and no per-tap branch, so the interior loop vectorises.
- * Lit and shadowed taps are counted apart: a NaN texel (or reference) is
- * neither, and makes the row NaN. */
-static float box_row_lit(const ShadowMap *m, int face, int i0, int j, int K, double ref)
+ * columns [i0, i0 + K) against one reference depth, rounded up to float32
+ * (smap_ref_up: the same outcomes as smap_test's double compare): smap_test
+ * with the row addressed once and no per-tap branch, in float lanes, so the
+ * interior loop vectorises. Lit and shadowed taps are counted apart: a NaN
+ * texel (or reference) is neither, and makes the row NaN. */
+static float box_row_lit(const ShadowMap *m, int face, int i0, int j, int K, float ref)
 {
     int res = m->res, jc = j < 0 ? 0 : j >= res ? res - 1 : j, lit = 0, shadowed = 0;
     const float *row = m->depth + ((size_t)face * (size_t)res + (size_t)jc) * (size_t)res;
@@ -133,7 +134,8 @@ static float filter_box(const PcfState *st, const SmapReceiver *r)
         for (int j = j0; j < j0 + st->K; j++)
             for (int i = i0; i < i0 + st->K; i++) lit += smap_lit(st->map, r, i, j);
     } else {
-        for (int j = j0; j < j0 + st->K; j++) lit += box_row_lit(st->map, r->mc.face, i0, j, st->K, r->ref);
+        float ref = smap_ref_up(r->ref);
+        for (int j = j0; j < j0 + st->K; j++) lit += box_row_lit(st->map, r->mc.face, i0, j, st->K, ref);
     }
     return lit / (float)(st->K * st->K);
 }
@@ -180,21 +182,31 @@ static float filter_disk(const PcfState *st, const SmapReceiver *r, uint32_t sam
     return lit / (float)st->samples;
 }
 
+static float pcf_filter(const PcfState *st, const SmapReceiver *r, int sample)
+{
+    switch (st->kernel) {
+    case KERNEL_BOX: return filter_box(st, r);
+    case KERNEL_BILINEAR: return filter_bilinear(st, r);
+    default: return filter_disk(st, r, (uint32_t)sample);
+    }
+}
+
+/* Receivers are set up SMAP_BATCH samples at a time (smap_receivers), then
+ * filtered one by one. */
 static void pcf_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
 {
     const PcfState *st = state;
-    for (int s = begin; s < end; s++) {
-        if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
-        SmapReceiver r;
-        float v = 1.0f;
-        if (smap_receiver(st->map, &st->bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r)) {
-            switch (st->kernel) {
-            case KERNEL_BOX: v = filter_box(st, &r); break;
-            case KERNEL_BILINEAR: v = filter_bilinear(st, &r); break;
-            default: v = filter_disk(st, &r, (uint32_t)s); break;
-            }
+    for (int first = begin; first < end; first += SMAP_BATCH) {
+        int n = end - first < SMAP_BATCH ? end - first : SMAP_BATCH;
+        SmapReceiver r[SMAP_BATCH];
+        bool inside[SMAP_BATCH];
+        smap_receivers(st->map, &st->bias, ctx->vs->p_world + first, ctx->vs->n_geom_world + first, ctx->cls + first,
+                       n, r, inside);
+        for (int k = 0; k < n; k++) {
+            int s = first + k;
+            if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+            tech_store(ctx, out, begin, s, inside[k] ? pcf_filter(st, &r[k], s) : 1.0f);
         }
-        tech_store(ctx, out, begin, s, v);
     }
 }
 

@@ -143,22 +143,14 @@ static double depth_slope(const SmapReceiver *r)
     return nan_max(fabs(r->gs), fabs(r->gt)) * k;
 }
 
-bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_geom_world, SmapReceiver *r)
+/* The bias and reference depth of a located receiver (lookup point p, the
+ * geometric normal n), whichever path located it. */
+static bool receiver_bias(const ShadowMap *m, const SmapBias *b, dvec3 p, dvec3 n, double ndc_per_world,
+                          SmapReceiver *r)
 {
-    const LightView *lv = &m->view;
-    dvec3 n = d3_from(n_geom_world);
-    dvec3 p = d3_madd(d3_from(p_world), n, rt_ray_offset(b->scene_extent, p_world));
-    r->mc = lightview_locate(lv, p);
-    r->texel_world = lightview_texel_world(lv, &r->mc);
-    if (b->normal_offset_texels > 0.0) {
-        p = d3_madd(p, n, b->normal_offset_texels * r->texel_world);
-        r->mc = lightview_locate(lv, p);
-        r->texel_world = lightview_texel_world(lv, &r->mc);
-    }
-    r->p_world = p;
+    r->p_world = p; /* the lookup point, whichever path located it (smrt marches from it) */
     r->plane = false;
     if (!r->mc.inside) return false;
-    double ndc_per_world = lightview_ndc_per_world(lv, &r->mc);
     double to_stored = m->spec.depth == RASTER_DEPTH_NDC ? ndc_per_world : 1.0;
     bool plane = (b->receiver_plane || b->slope > 0.0) && receiver_plane(m, r, p, n);
     /* Slope-scaled bias (course §2.1.2: faces aligned with the light's rays
@@ -174,4 +166,175 @@ bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_g
     r->ref = stored_depth(m, &r->mc) - r->bias;
     r->plane = plane && b->receiver_plane;
     return true;
+}
+
+/* Any map in double precision: lift, locate (any face, warp or cascade),
+ * normal offset, locate again. */
+static bool receiver_any(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_geom_world, SmapReceiver *r)
+{
+    const LightView *lv = &m->view;
+    dvec3 n = d3_from(n_geom_world);
+    dvec3 p = d3_madd(d3_from(p_world), n, rt_ray_offset(b->scene_extent, p_world));
+    r->mc = lightview_locate(lv, p);
+    r->texel_world = lightview_texel_world(lv, &r->mc);
+    if (b->normal_offset_texels > 0.0) {
+        p = d3_madd(p, n, b->normal_offset_texels * r->texel_world);
+        r->mc = lightview_locate(lv, p);
+        r->texel_world = lightview_texel_world(lv, &r->mc);
+    }
+    double ndc_per_world = r->mc.inside ? lightview_ndc_per_world(lv, &r->mc) : 0.0;
+    return receiver_bias(m, b, p, n, ndc_per_world, r);
+}
+
+/* ---- the batched float32 set-up of a plain projective map ---------------- */
+
+/* One unwarped ortho or perspective face, as lightview_locate_on,
+ * lightview_texel_world and lightview_ndc_per_world (lightview_lookup.c)
+ * read it, rounded to float32 once per batch. */
+typedef struct FaceF {
+    float clip[4][4]; /* clip_from_world */
+    float row[4];     /* linear depth = row . (p, 1), world units */
+    float res;        /* texels per side */
+    float texel;      /* texel width: world units (ortho), or per unit of depth (perspective) */
+    float near;       /* depth_near, world units */
+    float ndc_k;      /* perspective: f n / (f - n), dz_ndc/dd = ndc_k / d^2; ortho: 1 / (f - n) */
+    bool perspective;
+} FaceF;
+
+/* Where the batch path serves: one face (no cube, paraboloid, cascades or
+ * frustum-face partition), no warp. Other maps take receiver_any. */
+static bool face_float(const ShadowMap *m, FaceF *f)
+{
+    const LightView *lv = &m->view;
+    const MapFace *mf = &lv->face[0];
+    if (lv->num_faces != 1 || lv->num_cascades > 1 || lv->face_partition || mf->paraboloid ||
+        mf->warp != MAP_WARP_NONE)
+        return false;
+    for (int i = 0; i < 4; i++) {
+        for (int k = 0; k < 4; k++) f->clip[i][k] = (float)mf->raster.clip_from_world.m[i][k];
+        f->row[i] = (float)mf->raster.depth_row[i];
+    }
+    double n = mf->raster.depth_near, far = mf->raster.depth_far;
+    f->res = (float)lv->res;
+    f->texel = (float)(fmax(mf->r - mf->l, mf->t - mf->b) / lv->res);
+    f->near = (float)n;
+    f->perspective = mf->perspective;
+    f->ndc_k = (float)(mf->perspective ? far * n / (far - n) : 1.0 / (far - n));
+    return true;
+}
+
+/* A batch's lookup points and what locating them gives, one array per
+ * quantity (structure of arrays: the loop over them vectorises). */
+typedef struct BatchF {
+    float x[SMAP_BATCH], y[SMAP_BATCH], z[SMAP_BATCH];        /* lookup point, world */
+    float nx[SMAP_BATCH], ny[SMAP_BATCH], nz[SMAP_BATCH];     /* geometric normal, world */
+    float s[SMAP_BATCH], t[SMAP_BATCH];                       /* texel coordinates */
+    float z_ndc[SMAP_BATCH], depth[SMAP_BATCH];               /* post-projective and linear depth */
+    float texel_world[SMAP_BATCH], ndc_per_world[SMAP_BATCH]; /* texel width (world units), dz_ndc / d depth */
+    int inside[SMAP_BATCH];
+} BatchF;
+
+/* lightview_locate_on, lightview_texel_world and lightview_ndc_per_world of
+ * an unwarped face for points [0, n) of the batch, in float32 lanes: AVX2
+ * where the CPU has it, 8 lanes. Without -ftrapping-math's promise that a
+ * comparison with NaN may trap (no FP exception is unmasked here) GCC
+ * turns the selects into vector blends. */
+#if defined(__clang__)
+#define NO_TRAPPING_MATH /* clang: no such attribute, nor the need */
+#else
+#define NO_TRAPPING_MATH __attribute__((optimize("no-trapping-math")))
+#endif
+NO_TRAPPING_MATH __attribute__((target_clones("avx2", "default")))
+static void locate_batch(const FaceF *f, int n, BatchF *b)
+{
+    const float(*M)[4] = f->clip;
+    const float *row = f->row, res = f->res, near = f->near;
+    /* perspective: texel width k_t d, slope k_z / d^2; ortho: constants */
+    float kt = f->perspective ? f->texel : 0.0f, ct = f->perspective ? 0.0f : f->texel;
+    float kz = f->perspective ? f->ndc_k : 0.0f, cz = f->perspective ? 0.0f : f->ndc_k;
+    float pn = f->perspective ? 1.0f : 0.0f; /* ortho: the slope's denominator is 1 */
+#pragma omp simd
+    for (int i = 0; i < n; i++) {
+        float x = b->x[i], y = b->y[i], z = b->z[i];
+        float cx = M[0][0] * x + M[0][1] * y + M[0][2] * z + M[0][3];
+        float cy = M[1][0] * x + M[1][1] * y + M[1][2] * z + M[1][3];
+        float cq = M[2][0] * x + M[2][1] * y + M[2][2] * z + M[2][3];
+        float cw = M[3][0] * x + M[3][1] * y + M[3][2] * z + M[3][3];
+        float d = row[0] * x + row[1] * y + row[2] * z + row[3];
+        int front = cw > 0.0f; /* behind a perspective face's eye: outside */
+        float q = 1.0f / (front ? cw : 1.0f);
+        float s = (cx * q + 1.0f) * 0.5f * res, t = (cy * q + 1.0f) * 0.5f * res, zn = cq * q;
+        float dn = d < near ? near : d; /* depth clamped to the near plane (> 0 for perspective); NaN stays NaN */
+        b->s[i] = s;
+        b->t[i] = t;
+        b->z_ndc[i] = zn;
+        b->depth[i] = d;
+        b->texel_world[i] = kt * d + ct;
+        b->ndc_per_world[i] = kz / (pn * dn * dn + (1.0f - pn)) + cz;
+        b->inside[i] = front & (s >= 0.0f) & (s < res) & (t >= 0.0f) & (t < res) & (zn >= 0.0f) & (zn <= 1.0f);
+    }
+}
+
+/* Samples [0, n) of a batch on a FaceF map: lift by rt_ray_offset, locate,
+ * normal offset, locate again, then the biases per receiver. */
+static void receivers_float(const ShadowMap *m, const FaceF *f, const SmapBias *b, const vec3 *p_world,
+                            const vec3 *n_geom_world, const int *index, int n, SmapReceiver *r, bool *inside)
+{
+    BatchF B;
+    for (int k = 0; k < n; k++) {
+        vec3 p = p_world[index[k]], nrm = n_geom_world[index[k]];
+        float lift = rt_ray_offset(b->scene_extent, p);
+        B.nx[k] = nrm.x;
+        B.ny[k] = nrm.y;
+        B.nz[k] = nrm.z;
+        B.x[k] = p.x + nrm.x * lift;
+        B.y[k] = p.y + nrm.y * lift;
+        B.z[k] = p.z + nrm.z * lift;
+    }
+    locate_batch(f, n, &B);
+    if (b->normal_offset_texels > 0.0) {
+        float off = (float)b->normal_offset_texels;
+        for (int k = 0; k < n; k++) {
+            float step = off * B.texel_world[k];
+            B.x[k] += B.nx[k] * step;
+            B.y[k] += B.ny[k] * step;
+            B.z[k] += B.nz[k] * step;
+        }
+        locate_batch(f, n, &B);
+    }
+    for (int k = 0; k < n; k++) {
+        SmapReceiver *o = &r[index[k]];
+        o->mc = (MapCoord){.face = 0, .s = B.s[k], .t = B.t[k], .depth_linear = B.depth[k], .z_ndc = B.z_ndc[k],
+                           .inside = B.inside[k] != 0, .warp_w = 1.0};
+        o->texel_world = B.texel_world[k];
+        inside[index[k]] = receiver_bias(m, b, d3(B.x[k], B.y[k], B.z[k]), d3(B.nx[k], B.ny[k], B.nz[k]),
+                                         B.ndc_per_world[k], o);
+    }
+}
+
+void smap_receivers(const ShadowMap *m, const SmapBias *b, const vec3 *p_world, const vec3 *n_geom_world,
+                    const uint8_t *cls, int count, SmapReceiver *r, bool *inside)
+{
+    FaceF f;
+    bool batched = face_float(m, &f);
+    for (int first = 0; first < count; first += SMAP_BATCH) {
+        int index[SMAP_BATCH], n = 0;
+        for (int i = first; i < count && i < first + SMAP_BATCH; i++) {
+            inside[i] = false;
+            if (!cls || cls[i] == SAMPLE_LIT_CANDIDATE) index[n++] = i;
+        }
+        if (batched) {
+            receivers_float(m, &f, b, p_world, n_geom_world, index, n, r, inside);
+            continue;
+        }
+        for (int k = 0; k < n; k++)
+            inside[index[k]] = receiver_any(m, b, p_world[index[k]], n_geom_world[index[k]], &r[index[k]]);
+    }
+}
+
+bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_geom_world, SmapReceiver *r)
+{
+    bool inside;
+    smap_receivers(m, b, &p_world, &n_geom_world, NULL, 1, r, &inside);
+    return inside;
 }

@@ -189,6 +189,17 @@ typedef struct SmapReceiver {
  * should agree with `hard` wherever the surface faces the light squarely.
  * false when the sample falls outside the map (the technique decides: lit). */
 bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_geom_world, SmapReceiver *r);
+/* The same set-up for samples [0, count) of the arrays at once, those whose
+ * class is SAMPLE_LIT_CANDIDATE (cls NULL: all); inside[i] is what
+ * smap_receiver returns (false for the others, whose r[i] is not written).
+ * smap_receiver is a batch of one. On a plain projective map (one ortho or
+ * perspective face, no warp, cascades or cube) lifting, locating, the texel
+ * size and the depth slope run over SMAP_BATCH samples at a time in float32
+ * arrays, as a GPU's shader does; the biases then per receiver, in double.
+ * Other maps are located per sample in double (lightview_locate). */
+#define SMAP_BATCH 64
+void smap_receivers(const ShadowMap *m, const SmapBias *b, const vec3 *p_world, const vec3 *n_geom_world,
+                    const uint8_t *cls, int count, SmapReceiver *r, bool *inside);
 
 /* Reference depth at map point (s, t) of the receiver's face (texel units:
  * texel i covers [i, i + 1]): the receiver plane's there, else r->ref. */
@@ -212,6 +223,16 @@ static inline double smap_ref_at(const SmapReceiver *r, int i, int j)
 static inline float smap_test(double ref, double stored)
 {
     return ref > stored ? 0.0f : ref <= stored ? 1.0f : NAN;
+}
+
+/* The smallest float32 at or above a reference depth: against any stored
+ * float32 z, ref <= z exactly when smap_ref_up(ref) <= z (and ref > z when
+ * it is > z; NaN stays NaN), so a filter may compare its taps in float
+ * lanes with smap_test's results unchanged. */
+static inline float smap_ref_up(double ref)
+{
+    float f = (float)ref;
+    return (double)f < ref ? nextafterf(f, INFINITY) : f;
 }
 
 static inline float smap_lit(const ShadowMap *m, const SmapReceiver *r, int i, int j)
