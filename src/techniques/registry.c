@@ -29,6 +29,7 @@ extern const Technique tech_shadow_width;
 extern const Technique tech_aliasing;
 extern const Technique tech_backprojection;
 extern const Technique tech_light_sampling;
+extern const Technique tech_layered_attenuation;
 extern const Technique tech_occlusion_textures;
 extern const Technique tech_shadow_volume;
 extern const Technique tech_soft_shadow_volume;
@@ -62,6 +63,7 @@ static const Technique *const registry[] = {
     &tech_aliasing,
     &tech_backprojection,
     &tech_light_sampling,
+    &tech_layered_attenuation,
     &tech_occlusion_textures,
     &tech_shadow_volume,
     &tech_soft_shadow_volume,
