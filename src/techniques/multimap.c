@@ -43,7 +43,7 @@ enum { P_LS_SAMPLES = SMAP_P_BIAS, P_LS_PATTERN, P_EPSILON, P_LAYERS }; /* after
 static const ParamDesc la_params[] = {
     SMAP_MAP_PARAMS,
     LS_SAMPLE_PARAMS,
-    {"epsilon", PARAM_FLOAT, 0.2, 0, 1e6, "world units",
+    {"epsilon", PARAM_FLOAT, 0.1, 0, 1e6, "world units",
      "tolerance along the centre's depth axis within which a warped depth counts for an existing layer, and a "
      "receiver matches a layer (Agrawala et al. 2000); stiff: too small splits one surface into many layers "
      "(umbra everywhere), too large merges occluder and receiver (lit everywhere)",
