@@ -30,10 +30,10 @@
 
 #define LA_MAX_LAYERS 64
 /* Each source texel is warped at 2 x 2 points of its area (at its stored
- * depth), so the forward warp leaves no holes where sample k's grid is up
- * to twice as coarse as the centre's on a surface [derived: a texel's
- * footprint after a warp of magnification below 2 covers a point of each
- * target texel it overlaps only when sampled at half-texel spacing]. */
+ * depth): points half a source texel apart land at most one LDI texel apart
+ * while the warp magnifies a surface by up to 2, so every LDI texel the
+ * surface covers receives one and the forward warp leaves no holes
+ * [derived: a grid of spacing <= 1 texel meets every texel it spans]. */
 #define LA_WARP_SUB 2
 
 enum { P_LS_SAMPLES = SMAP_P_BIAS, P_LS_PATTERN, P_EPSILON, P_LAYERS }; /* after SMAP_MAP_PARAMS */
