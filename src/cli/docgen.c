@@ -82,11 +82,19 @@ static void technique_table(FILE *fp)
     }
 }
 
+/* How many of t's leading parameters are base's first `shared`, by name. */
+int docgen_shared_prefix(const Technique *base, const Technique *t, int shared)
+{
+    int k = 0;
+    while (k < shared && k < t->num_params && strcmp(t->params[k].name, base->params[k].name) == 0) k++;
+    return k;
+}
+
 void docgen_param_difference(const Technique *base_t, const Technique *t, int k, char *out, size_t n)
 {
     const ParamDesc *base = &base_t->params[k], *p = &t->params[k];
     char def[64], range[256];
-    if (!tech_param_offered(t, k)) {
+    if (docgen_shared_prefix(base_t, t, k + 1) <= k || !tech_param_offered(t, k)) {
         snprintf(out, n, "not taken");
         return;
     }
@@ -120,16 +128,17 @@ static void differences(const Technique *const *maps, int n, int k, char *out, s
     out[0] = (char)toupper((unsigned char)out[0]);
 }
 
-/* The parameters every map technique declares first: the names they all
- * share, in order (SMAP_MAP_PARAMS, SMAP_BIAS_PARAMS). */
+/* The parameters the map techniques declare first, in order: the map block
+ * (SMAP_MAP_PARAMS), which all declare, then as much of the bias block
+ * (SMAP_BIAS_PARAMS) as all that declare any of it share; a technique that
+ * compares no depths declares none of it (layered_attenuation: its
+ * tolerance replaces the biases), and its rows say "not taken". */
 static int shared_count(const Technique *const *maps, int n)
 {
     int shared = n > 0 ? maps[0]->num_params : 0;
     for (int i = 1; i < n; i++) {
-        int k = 0;
-        while (k < shared && k < maps[i]->num_params && strcmp(maps[i]->params[k].name, maps[0]->params[k].name) == 0)
-            k++;
-        shared = k;
+        int k = docgen_shared_prefix(maps[0], maps[i], shared);
+        if (k != SMAP_P_BIAS) shared = k; /* k == SMAP_P_BIAS: the map block only, the bias rows not taken */
     }
     return shared;
 }

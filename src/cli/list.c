@@ -58,9 +58,9 @@ static void print_all(void)
         for (int k = 0; map && k < shared; k++) {
             char what[320];
             docgen_param_difference(maps[0], t, k, what, sizeof what);
-            if (what[0]) printf("  -p %s: %s here\n", t->params[k].name, what);
+            if (what[0]) printf("  -p %s: %s here\n", maps[0]->params[k].name, what);
         }
-        for (int k = map ? shared : 0; k < t->num_params; k++)
+        for (int k = map ? docgen_shared_prefix(maps[0], t, shared) : 0; k < t->num_params; k++)
             if (tech_param_offered(t, k)) print_param(t, k);
         printf("\n");
     }

@@ -17,29 +17,18 @@
  * sphere looks oblique. */
 #include <stdlib.h>
 #include "core/hash.h"
-#include "core/sampling.h"
 #include "scene/light.h"
-#include "techniques/smap.h"
+#include "techniques/multimap.h"
 
-enum { PAT_R2, PAT_RANDOM };
-static const char *const pattern_names[] = {"r2", "random", NULL};
+const char *const ls_pattern_names[] = {"r2", "random", NULL};
 enum { P_SAMPLES = SMAP_NUM_DEPTH_BIAS_PARAMS, P_PATTERN };
-
-#define LS_MAX_SAMPLES 1024
 
 /* Each map is tested at one texel per sample: the receiver plane, a depth
  * per texel of a kernel, cannot act (SMAP_DEPTH_BIAS_PARAMS, as filtered.h). */
 static const ParamDesc ls_params[] = {
     SMAP_MAP_PARAMS,
     SMAP_DEPTH_BIAS_PARAMS,
-    {"samples", PARAM_INT, 16, 1, LS_MAX_SAMPLES, "maps",
-     "N: light samples, one shadow map of map_size^2 each (memory and build time grow as N; N maps above 2 GiB "
-     "together are refused)",
-     NULL},
-    {"pattern", PARAM_ENUM, PAT_R2, 0, 1, "",
-     "where on the light the samples lie: r2 (Roberts' low-discrepancy sequence, the reference's default "
-     "pattern: error falls faster than 1/sqrt(N)) or random (independent uniform points: 1/sqrt(N))",
-     pattern_names},
+    LS_SAMPLE_PARAMS,
 };
 
 static const char *const ls_resources[] = {"shadow_map", "view_samples", NULL};
@@ -75,10 +64,7 @@ static vec3 light_point(const Scene *scene, const Light *l, SamplingPattern patt
     return v3_madd(view, s.dir_world, s.dist);
 }
 
-/* The map from one light sample: the scene seen from a point light there
- * (its resource key holds the point, so every sample has its own map, and a
- * sweep over N reuses the first N's). */
-static const ShadowMap *sample_map(const TechContext *ctx, const ShadowMapSpec *spec, vec3 point, Error *err)
+const ShadowMap *ls_point_map(const TechContext *ctx, const ShadowMapSpec *spec, vec3 point, Error *err)
 {
     Scene s = *ctx->scene;
     Light l = {.kind = LIGHT_POINT, .position = point, .direction = ctx->light->direction,
@@ -96,6 +82,25 @@ static const ShadowMap *sample_map(const TechContext *ctx, const ShadowMapSpec *
     return res_shadow_map(ctx->rm, &s, 0, spec, err);
 }
 
+bool ls_sample_maps(const TechContext *ctx, const ShadowMapSpec *spec, int n, int pattern,
+                    vec3 *point, const ShadowMap **map, Error *err)
+{
+    Light sampled = sampled_light(ctx->scene, ctx->light);
+    SamplingPattern sp = pattern == LS_PAT_R2 ? SAMPLING_R2 : SAMPLING_RANDOM;
+    Light probe = {.kind = LIGHT_POINT, .position = ctx->light->position};
+    double total = (double)shadowmap_bytes_for(&probe, spec) * n;
+    if (total > (double)SHADOWMAP_MAX_BYTES)
+        return error_set(err, "samples = %d maps of map_size = %d take %.2f GiB, above the %.0f GiB "
+                              "limit: lower samples or map_size",
+                         n, spec->res, total / (1u << 30), (double)SHADOWMAP_MAX_BYTES / (1u << 30));
+    for (int k = 0; k < n; k++) {
+        point[k] = light_point(ctx->scene, &sampled, sp, k, n);
+        map[k] = ls_point_map(ctx, spec, point[k], err);
+        if (!map[k]) return false;
+    }
+    return true;
+}
+
 static bool ls_prepare(const TechContext *ctx, void **state, Error *err)
 {
     const double *p = ctx->params;
@@ -104,23 +109,9 @@ static bool ls_prepare(const TechContext *ctx, void **state, Error *err)
     st->n = (int)p[P_SAMPLES];
     st->bias = smap_depth_bias(p, ctx->scene);
     ShadowMapSpec spec = smap_spec(p);
-    Light sampled = sampled_light(ctx->scene, ctx->light);
-    SamplingPattern pattern = (int)p[P_PATTERN] == PAT_R2 ? SAMPLING_R2 : SAMPLING_RANDOM;
-    Light probe = {.kind = LIGHT_POINT, .position = ctx->light->position};
-    double total = (double)shadowmap_bytes_for(&probe, &spec) * st->n;
-    if (total > (double)SHADOWMAP_MAX_BYTES) {
+    if (!ls_sample_maps(ctx, &spec, st->n, (int)p[P_PATTERN], st->point, st->map, err)) {
         free(st);
-        return error_set(err, "light_sampling: samples = %d maps of map_size = %d take %.2f GiB, above the %.0f GiB "
-                              "limit: lower samples or map_size",
-                         (int)p[P_SAMPLES], spec.res, total / (1u << 30), (double)SHADOWMAP_MAX_BYTES / (1u << 30));
-    }
-    for (int k = 0; k < st->n; k++) {
-        st->point[k] = light_point(ctx->scene, &sampled, pattern, k, st->n);
-        st->map[k] = sample_map(ctx, &spec, st->point[k], err);
-        if (!st->map[k]) {
-            free(st);
-            return false;
-        }
+        return false;
     }
     *state = st;
     return true;

@@ -78,6 +78,9 @@ expect help_compare 0 "--samples" "--repeat" -- "$SL" compare --help
 expect help_reference 0 "--samples" "--measure" -- "$SL" reference --help
 expect list_shows_hard 0 "hard" "offset_scale" "course" -- "$SL" list
 expect list_shows_when_a_parameter_acts 0 "acts" "kernel=poisson" -- "$SL" list
+# a map technique without the bias block (layered_attenuation) keeps the shared rows, each "not taken", and its own
+expect list_map_technique_without_biases 0 "-p bias: not taken here" "-p normal_offset: not taken here" \
+    "-p epsilon=0.1" -- "$SL" list
 expect usage_vsm_takes_no_receiver_plane 2 "unknown parameter 'receiver_plane'" -- "$SL" render "$SCENE" -t vsm -p receiver_plane=true
 
 "$SL" list --json >"$TMP/list.json" 2>"$TMP/err"

@@ -40,6 +40,9 @@ static const struct { const char *param, *settings; } probes[] = {
     {"depth_bits", "slope_bias=0"},
     {"depth_bits", "sampling=exhaustive"},
     {"depth_bits", "depth=ndc"}, /* backprojection, occlusion_textures: linear depth's quantisation is absorbed */
+    /* layered_attenuation: depth precision shows once epsilon nears the depth step */
+    {"depth", "depth_bits=u16 epsilon=0.001"},
+    {"depth_bits", "epsilon=0.001"},
     {"stabilize", "projection=perspective"}, /* light_sampling: auto gives its point samples cube maps */
     {"extrusion", "distance=0.5"}, /* shadow_volume: the default finite length outreaches every shadow */
     {"split_2", "split_1=2"},
