@@ -99,7 +99,7 @@ static void hide_samples(Mapped *m, const P2 *q, int np, double orientation)
 static void map_triangle(Mapped *m, const vec3 *tri, bool front_only)
 {
     dvec3 poly[4];
-    int facing, np = exact_clip(&m->lp.f, tri, poly, &facing);
+    int facing, np = exact_clip(&m->lp.f, tri, poly, &facing, NULL);
     if (np < 3 || facing == 0) return; /* nothing in front, or edge-on: it hides no sample */
     if (front_only && facing < 0) return; /* a front face of the closed object hides the same samples */
     P2 q[4];
