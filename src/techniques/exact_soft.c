@@ -131,18 +131,27 @@ static bool possible_silhouette(const ExactCasters *c, const int *side, int n)
     return !opposite || (ball[t0] != LIGHT_FRONT && ball[t0] != LIGHT_BACK) || ball[t0] != ball[t1];
 }
 
-/* Edge e's entry under chunk k: its side count, then each side 3 t + k and
- * t's chunk; returns the ints written (written only when out is not NULL). */
-static long list_entry(const ExactCasters *c, const int *side, int ns, int *out)
+/* An edge's entry under a chunk: its side count, its sphere in edge_ball,
+ * then each side 3 t + k and t's chunk; returns the ints it takes (written
+ * only when out is not NULL). */
+static long list_entry(const ExactCasters *c, const int *side, int ns, int ball, int *out)
 {
     if (out) {
         out[0] = ns;
+        out[1] = ball;
         for (int i = 0; i < ns; i++) {
-            out[1 + 2 * i] = side[i];
-            out[2 + 2 * i] = c->tri_chunk[side[i] / 3];
+            out[2 + 2 * i] = side[i];
+            out[3 + 2 * i] = c->tri_chunk[side[i] / 3];
         }
     }
-    return 1 + 2 * (long)ns;
+    return 2 + 2 * (long)ns;
+}
+
+/* The sphere around side 3 t + k's edge (corner k -> k + 1 of t). */
+static Ball bound_edge(const ExactCasters *c, int side)
+{
+    dvec3 a = d3_from(c->tri[side]), b = d3_from(c->tri[side - side % 3 + (side + 1) % 3]);
+    return (Ball){d3_scale(d3_add(a, b), 0.5), 0.5 * d3_len(d3_sub(b, a)) * (1.0 + 1e-6)};
 }
 
 /* The sides of every edge (counting sort by edge id), then each possible
@@ -159,17 +168,20 @@ static bool list_edges(ExactCasters *c, const int32_t *edge)
     for (int e = 0; ok && e < c->num_edges; e++) first[e + 2] += first[e + 1];
     for (size_t k = 0; ok && k < n; k++) side[first[edge[k] + 1]++] = (int)k; /* first[e] .. first[e + 1]: e's */
     for (int pass = 0; ok && pass < 2; pass++) {
+        int balls = 0;
         for (int e = 0; e < c->num_edges; e++) {
             const int *se = &side[first[e]];
             int ns = first[e + 1] - first[e];
             if (!possible_silhouette(c, se, ns)) continue;
+            if (pass) c->edge_ball[balls] = bound_edge(c, se[0]);
+            balls++;
             for (int i = 0; i < ns; i++) {
                 int k = c->tri_chunk[se[i] / 3];
                 bool seen = false;
                 for (int j = 0; j < i; j++) seen |= c->tri_chunk[se[j] / 3] == k;
                 if (seen) continue;
                 int *out = pass ? &c->listing[c->chunk_edges[k] + fill[k]] : NULL;
-                long size = list_entry(c, se, ns, out);
+                long size = list_entry(c, se, ns, balls - 1, out);
                 if (pass) fill[k] += size;
                 else c->chunk_edges[k + 1] += size;
             }
@@ -177,7 +189,8 @@ static bool list_edges(ExactCasters *c, const int32_t *edge)
         if (pass == 0) {
             for (int k = 0; k < c->num_chunks; k++) c->chunk_edges[k + 1] += c->chunk_edges[k];
             c->listing = malloc(sizeof *c->listing * (size_t)(c->chunk_edges[c->num_chunks] + 1));
-            ok = c->listing != NULL;
+            c->edge_ball = malloc(sizeof *c->edge_ball * (size_t)(balls + 1));
+            ok = c->listing && c->edge_ball;
         }
     }
     free(first);
@@ -265,6 +278,7 @@ void exact_casters_free(ExactCasters *c)
     free(c->chunk_object);
     free(c->chunk_edges);
     free(c->listing);
+    free(c->edge_ball);
     free(c->tri);
     free(c->chunk_first);
     free(c->chunk_ball);
@@ -511,16 +525,47 @@ static int triangle_weight(const ExactCasters *c, const LightPoints *lp, ExactSc
     return w;
 }
 
-/* One entry's edge (its side count, then each side 3 t + k and t's chunk)
- * summed over its sides, if `chunk`, the chunk it is listed under, is the
- * first reached chunk of its sides; returns the entry's size. */
-static int sum_edge(const ExactCasters *c, const LightPoints *lp, ExactScratch *sc, const int *entry, int chunk,
-                    ExactEdgeFn fn, void *user)
+/* The samples' cone widened by EDGE_CONE_MARGIN radians, for the edges'
+ * spheres: an edge outside it crosses no segment between two kept samples'
+ * projections (they lie in the cone, which is convex) and is farther than
+ * EXACT_AMBIGUOUS_TAN from every sample, so leaving it out changes neither
+ * the counts nor near_edge. */
+#define EDGE_CONE_MARGIN 1e-4
+typedef struct Cone {
+    double cos_t, sin_t; /* of the widened half-angle */
+} Cone;
+
+static Cone widened_cone(double cos_cone)
 {
-    int ns = entry[0], weight = 0;
-    const int *side = entry + 1;
+    double t = fmin(acos(fmax(-1.0, fmin(1.0, cos_cone))) + EDGE_CONE_MARGIN, M_PI);
+    return (Cone){cos(t), sin(t)};
+}
+
+/* Does ball b reach the cone from org around c? The angle between b's
+ * centre and c at most the half-angle t plus the ball's angular radius
+ * p = asin(r / |w|): cos(angle) >= cos(t + p), by the sum formula, unless
+ * t + p passes pi (sin(t + p) < 0), where every direction is in. */
+static bool edge_in_cone(const Ball *b, const Frame *f, const Cone *cone)
+{
+    dvec3 w = d3_sub(b->centre, f->org);
+    double d2 = d3_dot(w, w);
+    if (d2 <= b->radius * b->radius) return true;
+    double d = sqrt(d2), sin_p = b->radius / d, cos_p = sqrt(1.0 - sin_p * sin_p);
+    if (cone->sin_t * cos_p + cone->cos_t * sin_p < 0.0) return true;
+    return d3_dot(w, f->c) >= d * (cone->cos_t * cos_p - cone->sin_t * sin_p);
+}
+
+/* One entry's edge summed over its sides, if `chunk`, the chunk it is
+ * listed under, is the first reached chunk of its sides and its sphere
+ * reaches the cone; returns the entry's size. */
+static int sum_edge(const ExactCasters *c, const LightPoints *lp, const Cone *cone, ExactScratch *sc,
+                    const int *entry, int chunk, ExactEdgeFn fn, void *user)
+{
+    int ns = entry[0], weight = 0, size = 2 + 2 * ns;
+    const int *side = entry + 2;
     for (int i = 0; i < ns; i++)
-        if (side[2 * i + 1] < chunk && sc->reached[side[2 * i + 1]]) return 1 + 2 * ns; /* summed there */
+        if (side[2 * i + 1] < chunk && sc->reached[side[2 * i + 1]]) return size; /* summed there */
+    if (!edge_in_cone(&c->edge_ball[entry[1]], &lp->f, cone)) return size;
     dvec3 a = {0}, b = {0};
     for (int i = 0; i < ns; i++) {
         int t = side[2 * i] / 3, w = triangle_weight(c, lp, sc, t, side[2 * i + 1]);
@@ -535,7 +580,7 @@ static int sum_edge(const ExactCasters *c, const LightPoints *lp, ExactScratch *
         weight += exact_canonical(&a, &b) ? -w : w;
     }
     if (weight != 0) fn(user, a, b, weight);
-    return 1 + 2 * ns;
+    return size;
 }
 
 /* Does triangle t cross the clip plane (corners on both sides)? */
@@ -586,9 +631,11 @@ void exact_for_silhouette(const ExactCasters *c, const LightPoints *lp, ExactScr
         sc->org = 1;
     }
     mark_reached(c, lp, sc->reached);
+    Cone cone = widened_cone(lp->cos_cone);
     for (int k = 0; k < c->num_chunks; k++) {
         if (!sc->reached[k]) continue;
-        for (long i = c->chunk_edges[k]; i < c->chunk_edges[k + 1];) i += sum_edge(c, lp, sc, &c->listing[i], k, fn, user);
+        for (long i = c->chunk_edges[k]; i < c->chunk_edges[k + 1];)
+            i += sum_edge(c, lp, &cone, sc, &c->listing[i], k, fn, user);
         clip_plane_edges(c, lp, sc, k, fn, user);
     }
 }

@@ -66,10 +66,11 @@ typedef struct ExactCasters {
      * undirected edges of the welded casters (equal positions, -0 = +0,
      * across objects), each an entry (its side count, then each side 3 t + k
      * of a triangle t that traverses it from corner k to k + 1, and t's
-     * chunk) listed under each chunk of its triangles. */
+     * chunk) listed under each chunk of its triangles, with its sphere. */
     int num_edges;       /* all welded edges */
     long *chunk_edges;   /* per chunk: the offset of its entries in listing; num_chunks + 1 */
     int *listing;
+    Ball *edge_ball;
 } ExactCasters;
 
 /* Checks the sample parameters, acquires the casters' BVH and their
