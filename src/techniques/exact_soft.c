@@ -304,15 +304,24 @@ bool exact_casters_init(const TechContext *ctx, ExactCasters *c, Error *err)
     return false;
 }
 
-/* Can ball b reach the cone from org around f->c of half-angle acos(cos_cone)?
- * The ball subtends asin(r / |m - org|) about m - org. */
-static bool ball_in_cone(const Ball *b, const Frame *f, double cos_cone)
+Cone exact_cone(double cos_cone, double margin)
+{
+    double t = fmin(acos(fmax(-1.0, fmin(1.0, cos_cone))) + margin, M_PI);
+    return (Cone){cos(t), sin(t)};
+}
+
+/* Can ball b reach the cone from org about f->c? The angle between b's
+ * centre and c at most the half-angle t plus the ball's angular radius
+ * p = asin(r / |w|): cos(angle) >= cos(t + p), by the sum formula, unless
+ * t + p passes pi (sin(t + p) < 0), where every direction is in. */
+static bool ball_in_cone(const Ball *b, const Frame *f, const Cone *cone)
 {
     dvec3 w = d3_sub(b->centre, f->org);
-    double dist = d3_len(w);
-    if (dist <= b->radius) return true;
-    double axis = acos(fmax(-1.0, fmin(1.0, d3_dot(w, f->c) / dist)));
-    return axis - asin(b->radius / dist) <= acos(fmax(-1.0, fmin(1.0, cos_cone))) + 1e-9;
+    double d2 = d3_dot(w, w);
+    if (d2 <= b->radius * b->radius) return true;
+    double d = sqrt(d2), sin_p = b->radius / d, cos_p = sqrt(1.0 - sin_p * sin_p);
+    if (cone->sin_t * cos_p + cone->cos_t * sin_p < 0.0) return true;
+    return d3_dot(w, f->c) >= d * (cone->cos_t * cos_p - cone->sin_t * sin_p);
 }
 
 /* Are org and the whole light (ball) strictly on one side of triangle t's
@@ -332,15 +341,15 @@ static bool outside_closed(const ExactCasters *c, int o, const Frame *f)
 }
 
 /* Visits (fn) or finds (fn NULL) the triangles reaching the cone. */
-static bool visit_casters(const ExactCasters *c, const Frame *f, double cos_cone, ExactTriangleFn fn,
+static bool visit_casters(const ExactCasters *c, const Frame *f, const Cone *cone, ExactTriangleFn fn,
                           void *user)
 {
     bool any = false;
     for (int o = 0; o < c->num_objects; o++) {
-        if (!ball_in_cone(&c->object_ball[o], f, cos_cone)) continue;
+        if (!ball_in_cone(&c->object_ball[o], f, cone)) continue;
         bool front_only = outside_closed(c, o, f);
         for (int k = c->object_first[o]; k < c->object_first[o + 1]; k++) {
-            if (!ball_in_cone(&c->chunk_ball[k], f, cos_cone)) continue;
+            if (!ball_in_cone(&c->chunk_ball[k], f, cone)) continue;
             for (int t = c->chunk_first[k]; t < c->chunk_first[k + 1]; t++) {
                 if (plane_separates(c, t, f)) continue;
                 if (!fn) return true;
@@ -354,12 +363,12 @@ static bool visit_casters(const ExactCasters *c, const Frame *f, double cos_cone
 
 void exact_for_casters(const ExactCasters *c, const LightPoints *lp, ExactTriangleFn fn, void *user)
 {
-    visit_casters(c, &lp->f, lp->cos_cone, fn, user);
+    visit_casters(c, &lp->f, &lp->cone, fn, user);
 }
 
 bool exact_object_reaches(const ExactCasters *c, int o, const LightPoints *lp)
 {
-    return ball_in_cone(&c->object_ball[o], &lp->f, lp->cos_cone);
+    return ball_in_cone(&c->object_ball[o], &lp->f, &lp->cone);
 }
 
 bool exact_front_faces_suffice(const ExactCasters *c, int o, const LightPoints *lp)
@@ -369,7 +378,7 @@ bool exact_front_faces_suffice(const ExactCasters *c, int o, const LightPoints *
 
 bool exact_chunk_reaches(const ExactCasters *c, int k, const LightPoints *lp)
 {
-    return ball_in_cone(&c->chunk_ball[k], &lp->f, lp->cos_cone);
+    return ball_in_cone(&c->chunk_ball[k], &lp->f, &lp->cone);
 }
 
 bool exact_triangle_reaches(const ExactCasters *c, int t, const LightPoints *lp)
@@ -390,7 +399,8 @@ bool exact_begin(const ExactCasters *c, const TechContext *ctx, int s, LightPoin
     lp->light = light_ball(ctx->light);
     double dist = d3_len(d3_sub(lp->light.centre, f->org)), r = lp->light.radius;
     double cos_light = dist <= r ? -1.0 : sqrt(1.0 - (r / dist) * (r / dist)); /* every light point is inside */
-    return visit_casters(c, f, cos_light, NULL, NULL);
+    Cone cone = exact_cone(cos_light, EXACT_CONE_MARGIN);
+    return visit_casters(c, f, &cone, NULL, NULL);
 }
 
 void exact_draw(LightPoints *lp, const TechContext *ctx, int s)
@@ -418,6 +428,7 @@ void exact_draw(LightPoints *lp, const TechContext *ctx, int s)
         lp->lo = (P2){fmin(lp->lo.x, lp->x[i].x), fmin(lp->lo.y, lp->x[i].y)};
         lp->hi = (P2){fmax(lp->hi.x, lp->x[i].x), fmax(lp->hi.y, lp->x[i].y)};
     }
+    lp->cone = exact_cone(lp->cos_cone, EXACT_CONE_MARGIN);
 }
 
 bool exact_occluded(const ExactCasters *c, vec3 org, const LightSample *ls)
@@ -500,10 +511,10 @@ static void mark_reached(const ExactCasters *c, const LightPoints *lp, uint8_t *
 {
     uint8_t *object = reached + c->num_chunks;
     for (int o = 0; o < c->num_objects; o++) {
-        bool in = ball_in_cone(&c->object_ball[o], &lp->f, lp->cos_cone);
+        bool in = ball_in_cone(&c->object_ball[o], &lp->f, &lp->cone);
         object[o] = in ? (uint8_t)(1 + outside_closed(c, o, &lp->f)) : 0;
         for (int k = c->object_first[o]; k < c->object_first[o + 1]; k++)
-            reached[k] = in && ball_in_cone(&c->chunk_ball[k], &lp->f, lp->cos_cone);
+            reached[k] = in && ball_in_cone(&c->chunk_ball[k], &lp->f, &lp->cone);
     }
 }
 
@@ -531,29 +542,6 @@ static int triangle_weight(const ExactCasters *c, const LightPoints *lp, ExactSc
  * EXACT_AMBIGUOUS_TAN from every sample, so leaving it out changes neither
  * the counts nor near_edge. */
 #define EDGE_CONE_MARGIN 1e-4
-typedef struct Cone {
-    double cos_t, sin_t; /* of the widened half-angle */
-} Cone;
-
-static Cone widened_cone(double cos_cone)
-{
-    double t = fmin(acos(fmax(-1.0, fmin(1.0, cos_cone))) + EDGE_CONE_MARGIN, M_PI);
-    return (Cone){cos(t), sin(t)};
-}
-
-/* Does ball b reach the cone from org around c? The angle between b's
- * centre and c at most the half-angle t plus the ball's angular radius
- * p = asin(r / |w|): cos(angle) >= cos(t + p), by the sum formula, unless
- * t + p passes pi (sin(t + p) < 0), where every direction is in. */
-static bool edge_in_cone(const Ball *b, const Frame *f, const Cone *cone)
-{
-    dvec3 w = d3_sub(b->centre, f->org);
-    double d2 = d3_dot(w, w);
-    if (d2 <= b->radius * b->radius) return true;
-    double d = sqrt(d2), sin_p = b->radius / d, cos_p = sqrt(1.0 - sin_p * sin_p);
-    if (cone->sin_t * cos_p + cone->cos_t * sin_p < 0.0) return true;
-    return d3_dot(w, f->c) >= d * (cone->cos_t * cos_p - cone->sin_t * sin_p);
-}
 
 /* One entry's edge summed over its sides, if `chunk`, the chunk it is
  * listed under, is the first reached chunk of its sides and its sphere
@@ -565,7 +553,7 @@ static int sum_edge(const ExactCasters *c, const LightPoints *lp, const Cone *co
     const int *side = entry + 2;
     for (int i = 0; i < ns; i++)
         if (side[2 * i + 1] < chunk && sc->reached[side[2 * i + 1]]) return size; /* summed there */
-    if (!edge_in_cone(&c->edge_ball[entry[1]], &lp->f, cone)) return size;
+    if (!ball_in_cone(&c->edge_ball[entry[1]], &lp->f, cone)) return size;
     dvec3 a = {0}, b = {0};
     for (int i = 0; i < ns; i++) {
         int t = side[2 * i] / 3, w = triangle_weight(c, lp, sc, t, side[2 * i + 1]);
@@ -592,12 +580,15 @@ static bool crosses_clip_plane(const vec3 *t, const Frame *f)
 }
 
 /* The edges along the clip plane of chunk k's visited triangles that cross
- * it, if its sphere reaches the plane. */
-static void clip_plane_edges(const ExactCasters *c, const LightPoints *lp, ExactScratch *sc, int k, ExactEdgeFn fn,
-                             void *user)
+ * it, if its sphere comes near org: the plane h = EXACT_CLIP_EPS meets the
+ * widened cone (half-angle t < pi/2) within EXACT_CLIP_EPS / cos t of org,
+ * so a clip edge farther away is outside it (as an edge's sphere, above). */
+static void clip_plane_edges(const ExactCasters *c, const LightPoints *lp, const Cone *cone, ExactScratch *sc, int k,
+                             ExactEdgeFn fn, void *user)
 {
     const Ball *ball = &c->chunk_ball[k];
-    if (d3_dot(d3_sub(ball->centre, lp->f.org), lp->f.c) - ball->radius >= EXACT_CLIP_EPS) return;
+    double reach = cone->cos_t > 0.0 ? 2.0 * EXACT_CLIP_EPS / cone->cos_t + 1e-12 : INFINITY;
+    if (d3_len(d3_sub(ball->centre, lp->f.org)) - ball->radius > reach) return;
     for (int t = c->chunk_first[k]; t < c->chunk_first[k + 1]; t++) {
         if (!crosses_clip_plane(&c->tri[3 * t], &lp->f)) continue;
         int w = triangle_weight(c, lp, sc, t, k);
@@ -631,11 +622,11 @@ void exact_for_silhouette(const ExactCasters *c, const LightPoints *lp, ExactScr
         sc->org = 1;
     }
     mark_reached(c, lp, sc->reached);
-    Cone cone = widened_cone(lp->cos_cone);
+    Cone cone = exact_cone(lp->cos_cone, EDGE_CONE_MARGIN);
     for (int k = 0; k < c->num_chunks; k++) {
         if (!sc->reached[k]) continue;
         for (long i = c->chunk_edges[k]; i < c->chunk_edges[k + 1];)
             i += sum_edge(c, lp, &cone, sc, &c->listing[i], k, fn, user);
-        clip_plane_edges(c, lp, sc, k, fn, user);
+        clip_plane_edges(c, lp, &cone, sc, k, fn, user);
     }
 }

@@ -96,6 +96,14 @@ static inline P2 exact_project(const Frame *f, dvec3 d)
 /* Twice the signed area of (a, b, p): > 0 with p left of a -> b. */
 static inline double exact_orient(P2 a, P2 b, P2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }
 
+/* A cone about the frame's c from org: its half-angle t's cosine and sine. */
+typedef struct Cone {
+    double cos_t, sin_t;
+} Cone;
+#define EXACT_CONE_MARGIN 1e-9 /* radians the casters' culls widen a cone by */
+/* The cone of half-angle acos(cos_cone) + margin (at most pi). */
+Cone exact_cone(double cos_cone, double margin);
+
 /* One view sample's light samples. */
 typedef struct LightPoints {
     vec3 org;                          /* ray origin, world */
@@ -107,6 +115,7 @@ typedef struct LightPoints {
     bool above[EXACT_MAX_SAMPLES];     /* kept */
     P2 lo, hi;                         /* bounds of the kept projections */
     double cos_cone;                   /* the kept directions' least cosine to c */
+    Cone cone;                         /* theirs, widened by EXACT_CONE_MARGIN: the casters' culls */
 } LightPoints;
 
 /* The frame and the light's bounding sphere for view sample s; false when
