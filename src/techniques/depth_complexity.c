@@ -150,7 +150,7 @@ static bool dc_prepare(const TechContext *ctx, void **state, Error *err)
 {
     ExactCasters *cs = malloc(sizeof *cs);
     if (!cs) return error_set(err, "out of memory");
-    if (!exact_casters_init(ctx, cs, err)) {
+    if (!exact_casters_init(ctx, ctx->params[DC_P_EDGES] == DC_EDGES_SILHOUETTE, cs, err)) {
         free(cs);
         return false;
     }

@@ -199,10 +199,12 @@ static bool list_edges(ExactCasters *c, const int32_t *edge)
     return ok;
 }
 
-static bool build_edges(ExactCasters *c, const Ball *light)
+/* The triangles' planes, and the possible silhouette edges if wanted. */
+static bool build_edges(ExactCasters *c, const Ball *light, bool edges_wanted)
 {
     size_t n = 3 * (size_t)c->num_tris;
     for (int t = 0; t < c->num_tris; t++) plane_and_side(&c->tri[3 * t], light, &c->tri_normal[t], &c->tri_light_side[t]);
+    if (!edges_wanted) return true;
     int32_t *edge = malloc(sizeof *edge * (n + 1));
     long edges = edge ? number_edges(c->tri, n, edge) : -1;
     c->num_edges = (int)edges;
@@ -234,7 +236,8 @@ static bool object_closed(const Silhouette *sil, int object)
     return false;
 }
 
-static bool collect_casters(const Scene *scene, const Silhouette *sil, const Ball *light, ExactCasters *c, Error *err)
+static bool collect_casters(const Scene *scene, const Silhouette *sil, const Ball *light, bool edges, ExactCasters *c,
+                            Error *err)
 {
     long n = 0, chunks = 0;
     int objects = 0;
@@ -267,7 +270,7 @@ static bool collect_casters(const Scene *scene, const Silhouette *sil, const Bal
     c->object_first[c->num_objects] = c->num_chunks;
     for (int k = 0; k < c->num_chunks; k++)
         c->chunk_ball[k] = bound_corners(c->tri, 3 * c->chunk_first[k], 3 * c->chunk_first[k + 1]);
-    return build_edges(c, light) || error_set(err, "out of memory for the edges of %ld caster triangles", n);
+    return build_edges(c, light, edges) || error_set(err, "out of memory for the edges of %ld caster triangles", n);
 }
 
 void exact_casters_free(ExactCasters *c)
@@ -287,7 +290,7 @@ void exact_casters_free(ExactCasters *c)
     free(c->object_closed);
 }
 
-bool exact_casters_init(const TechContext *ctx, ExactCasters *c, Error *err)
+bool exact_casters_init(const TechContext *ctx, bool edges, ExactCasters *c, Error *err)
 {
     *c = (ExactCasters){0};
     if (!sampling_check_count((SamplingPattern)ctx->params[EXACT_P_PATTERN], (int)ctx->params[EXACT_P_SAMPLES], err))
@@ -299,7 +302,7 @@ bool exact_casters_init(const TechContext *ctx, ExactCasters *c, Error *err)
     c->rtc = rt_scene_handle(bvh);
     c->extent = scene_extent(ctx->scene);
     Ball light = light_ball(ctx->light);
-    if (collect_casters(ctx->scene, sil, &light, c, err)) return true;
+    if (collect_casters(ctx->scene, sil, &light, edges, c, err)) return true;
     exact_casters_free(c);
     return false;
 }

@@ -74,8 +74,9 @@ typedef struct ExactCasters {
 } ExactCasters;
 
 /* Checks the sample parameters, acquires the casters' BVH and their
- * silhouette resource (for each object's closedness) and gathers them. */
-bool exact_casters_init(const TechContext *ctx, ExactCasters *c, Error *err);
+ * silhouette resource (for each object's closedness) and gathers them, with
+ * the possible silhouette edges of exact_for_silhouette if `edges`. */
+bool exact_casters_init(const TechContext *ctx, bool edges, ExactCasters *c, Error *err);
 void exact_casters_free(ExactCasters *c);
 
 /* The normalised light frame at org. */
