@@ -20,9 +20,11 @@
  * canonical endpoint order) and an open edge steps once: Laine's per-edge
  * update with the edge's multiplicity, summed over the triangles that carry
  * it. With edges=silhouette (exact_for_silhouette, Laine et al. 2005 §4's
- * two stages) only the light's possible silhouette edges in the chunks that
- * reach the cone are summed, and only those whose sum is not 0 run over the
- * light samples: the same counts as edges=all's every triangle. Crossing into a front-facing triangle's projection raises D by 1. A
+ * two stages) only the light's possible silhouette edges that reach the
+ * samples' cone are summed, and only those whose sum is not 0 run over the
+ * light samples: the same counts as edges=all's every triangle (bunny,
+ * 160x120, 256 samples: 4.4 s against 52.8 s). Crossing into a
+ * front-facing triangle's projection raises D by 1. A
  * closed caster (silhouette.h) seen from outside its bounding sphere counts
  * its front faces only: D halves there, and is 0 where it was.
  *
@@ -52,9 +54,10 @@ static const ParamDesc dc_params[] = {
                         "N: depth-complexity counters per view sample (Laine et al. 2005 used 256-1024); the "
                         "reference's --samples gives the same points"),
     {"edges", PARAM_ENUM, DC_EDGES_SILHOUETTE, 0, 1, "",
-     "which edges step the counters: silhouette (the visited triangles' edges summed per caster edge, those that "
-     "cancel left out: Laine et al. 2005 §4) or all (every visited triangle's edges, the brute force): the same "
-     "visibility, bit for bit; all is slower (bunny 160x120: ~10x) and its near_edge also counts interior edges",
+     "which edges step the counters: silhouette (Laine et al. 2005 §4's two stages: the light's possible "
+     "silhouette edges whose spheres reach the samples' cone, summed over their triangles from the view sample, "
+     "the sums not 0 stepping) or all (every visited triangle's edges, the brute force): the same visibility bit "
+     "for bit; all is ~12x slower on the bunny at 160x120 and its near_edge also counts edges inside a surface",
      dc_edge_names},
 };
 

@@ -174,11 +174,15 @@ static inline bool exact_canonical(dvec3 *a, dvec3 *b)
  * one, once per light (exact_casters_init): the possible silhouette edges of
  * the light's bounding ball, every edge except a consistently oriented edge
  * of two triangles that both have the whole ball strictly on one side and
- * the same side (then from no light point is it a silhouette), listed under
- * the chunks of their triangles (the paper's hemicube cells over the light's
- * projections: here the chunks' bounding spheres culled against the cone to
- * the light). Stage two, per org: the listed edges of the chunks that reach
- * the cone, each summed over its triangles as exact_for_casters visits them
+ * the same side (then from no light point is it a silhouette), each with
+ * its bounding sphere, listed under the chunks of their triangles (where the
+ * paper bins them in a hemicube about the light, the chunks' and the edges'
+ * spheres are culled against the cone from org to the light, which is the
+ * wedge test seen from org: an edge's wedge holds org iff the edge meets
+ * that cone). Stage two, per org: the listed edges of the chunks that reach
+ * the cone whose spheres reach it too (widened by EDGE_CONE_MARGIN, so
+ * neither the counts nor near_edge lose anything), each summed over its
+ * triangles as exact_for_casters visits them
  * (culling, facing from org, front_only, the clip to d.c >= EXACT_CLIP_EPS
  * from the inside corner, canonical order), and fn called with the sum where
  * it is not 0; also fn for each visited clipped triangle's edge along the
