@@ -19,7 +19,12 @@
  * cancel exactly (the crossing predicate is evaluated on the edge's
  * canonical endpoint order) and an open edge steps once: Laine's per-edge
  * update with the edge's multiplicity, summed over the triangles that carry
- * it. Crossing into a front-facing triangle's projection raises D by 1. A
+ * it. With edges=silhouette (exact_for_silhouette, Laine et al. 2005 §4's
+ * two stages) only the light's possible silhouette edges that reach the
+ * samples' cone are summed, and only those whose sum is not 0 run over the
+ * light samples: the same counts as edges=all's every triangle (bunny,
+ * 160x120, 256 samples: 4.4 s against 52.8 s). Crossing into a
+ * front-facing triangle's projection raises D by 1. A
  * closed caster (silhouette.h) seen from outside its bounding sphere counts
  * its front faces only: D halves there, and is 0 where it was.
  *
@@ -33,16 +38,27 @@
  * Assumption (Laine et al. 2005's): the casters lie between the receivers and
  * the light; geometry beyond a light sample is counted as if in front.
  * `near_edge` (aux) counts the light samples whose projection lies within
- * EXACT_AMBIGUOUS_TAN of a projected edge, and those left out off the frame's axis: there the float ray test and the
+ * EXACT_AMBIGUOUS_TAN of a projected edge that steps the counts (a silhouette
+ * edge from org, or a clipped triangle's edge on the clip plane), and those left out off the frame's axis: there the float ray test and the
  * projected predicate may disagree. */
 #include <math.h>
 #include <stdlib.h>
 #include "techniques/exact_soft.h"
 
+enum { DC_P_EDGES = EXACT_NUM_SAMPLE_PARAMS };
+enum { DC_EDGES_SILHOUETTE, DC_EDGES_ALL };
+static const char *const dc_edge_names[] = {"silhouette", "all", NULL};
+
 static const ParamDesc dc_params[] = {
     EXACT_SAMPLE_PARAMS(16, 256,
                         "N: depth-complexity counters per view sample (Laine et al. 2005 used 256-1024); the "
                         "reference's --samples gives the same points"),
+    {"edges", PARAM_ENUM, DC_EDGES_SILHOUETTE, 0, 1, "",
+     "which edges step the counters: silhouette (Laine et al. 2005 §4's two stages: the light's possible "
+     "silhouette edges whose spheres reach the samples' cone, summed over their triangles from the view sample, "
+     "the sums not 0 stepping) or all (every visited triangle's edges, the brute force): the same visibility bit "
+     "for bit; all is ~12x slower on the bunny at 160x120 and its near_edge also counts edges inside a surface",
+     dc_edge_names},
 };
 
 static const char *const dc_resources[] = {"embree_bvh", "silhouette", NULL};
@@ -50,10 +66,12 @@ static const char *const dc_aux[] = {"near_edge", NULL};
 
 /* Laine's counters for one view sample. */
 typedef struct Counters {
+    bool silhouette;               /* edges=silhouette: exact_for_silhouette, else every visited triangle's edges */
+    ExactScratch scratch;          /* exact_for_silhouette's */
     LightPoints lp;
     P2 r;                          /* the point the counts are relative to */
     int rel[EXACT_MAX_SAMPLES];    /* relative depth complexity */
-    bool near[EXACT_MAX_SAMPLES];  /* within EXACT_AMBIGUOUS_TAN of a projected edge */
+    bool near[EXACT_MAX_SAMPLES];  /* within EXACT_AMBIGUOUS_TAN of a projected edge that steps them */
 } Counters;
 
 /* Signed steps of the edge a -> b (clipped, relative to org) added to every
@@ -61,16 +79,11 @@ typedef struct Counters {
  * projection, with weight w (the triangle's facing). The predicate runs on
  * the lexicographically smaller endpoint first, so the reversed edge of a
  * neighbour gives exactly the opposite steps. */
-static void add_edge(Counters *k, dvec3 a, dvec3 b, int w)
+static void add_edge(void *user, dvec3 a, dvec3 b, int w)
 {
+    Counters *k = user;
     const LightPoints *lp = &k->lp;
-    bool swap = a.x > b.x || (a.x == b.x && (a.y > b.y || (a.y == b.y && a.z > b.z)));
-    if (swap) {
-        dvec3 t = a;
-        a = b;
-        b = t;
-        w = -w;
-    }
+    if (exact_canonical(&a, &b)) w = -w;
     P2 qa = exact_project(&lp->f, a), qb = exact_project(&lp->f, b);
     if (fmax(qa.x, qb.x) < lp->lo.x || fmin(qa.x, qb.x) > lp->hi.x || fmax(qa.y, qb.y) < lp->lo.y ||
         fmin(qa.y, qb.y) > lp->hi.y)
@@ -103,7 +116,7 @@ static void add_edge(Counters *k, dvec3 a, dvec3 b, int w)
 static void add_triangle(void *user, const vec3 *tri, bool front_only)
 {
     dvec3 poly[4];
-    int w, np = exact_clip(&((Counters *)user)->lp.f, tri, poly, &w);
+    int w, np = exact_clip(&((Counters *)user)->lp.f, tri, poly, &w, NULL);
     if (w == 0 || (front_only && w < 0)) return; /* edge-on from org: it blocks no segment */
     for (int k = 0; k < np; k++) add_edge(user, poly[k], poly[(k + 1) % np], w);
 }
@@ -123,7 +136,8 @@ static float sample_visibility(const ExactCasters *cs, const TechContext *ctx, i
         k->rel[i] = 0;
         k->near[i] = false;
     }
-    exact_for_casters(cs, lp, add_triangle, k);
+    if (k->silhouette) exact_for_silhouette(cs, lp, &k->scratch, add_edge, k);
+    else exact_for_casters(cs, lp, add_triangle, k);
     int best = first;
     for (int i = first; i < lp->n; i++)
         if (lp->above[i] && k->rel[i] < k->rel[best]) best = i;
@@ -139,7 +153,7 @@ static bool dc_prepare(const TechContext *ctx, void **state, Error *err)
 {
     ExactCasters *cs = malloc(sizeof *cs);
     if (!cs) return error_set(err, "out of memory");
-    if (!exact_casters_init(ctx, cs, err)) {
+    if (!exact_casters_init(ctx, ctx->params[DC_P_EDGES] == DC_EDGES_SILHOUETTE, cs, err)) {
         free(cs);
         return false;
     }
@@ -155,14 +169,22 @@ static void dc_release(void *state)
 
 static void dc_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
 {
+    const ExactCasters *cs = state;
     Counters *k = malloc(sizeof *k);
+    if (k) k->silhouette = ctx->params[DC_P_EDGES] == DC_EDGES_SILHOUETTE;
+    if (k && !exact_scratch_init(&k->scratch, cs)) {
+        exact_scratch_free(&k->scratch);
+        free(k);
+        k = NULL;
+    }
     for (int s = begin; s < end; s++) {
         if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
         int near = 0;
-        float v = k ? sample_visibility(state, ctx, s, k, &near) : NAN; /* out of memory: no value */
+        float v = k ? sample_visibility(cs, ctx, s, k, &near) : NAN; /* out of memory: no value */
         tech_store(ctx, out, begin, s, v);
         if (ctx->aux) ctx->aux[s] = (float)near;
     }
+    if (k) exact_scratch_free(&k->scratch);
     free(k);
 }
 

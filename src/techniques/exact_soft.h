@@ -17,6 +17,7 @@
  * one that has not is left out and counted, `off_axis`). */
 #ifndef SL_EXACT_SOFT_H
 #define SL_EXACT_SOFT_H
+#include <stdint.h>
 #include "core/mat4.h"
 #include "core/sampling.h"
 #include "rt/rt.h"
@@ -57,11 +58,25 @@ typedef struct ExactCasters {
     int *object_first; /* per caster object: its first chunk; num_objects + 1 */
     Ball *object_ball;
     bool *object_closed; /* a closed 2-manifold (resources/silhouette.h's adjacency) */
+    int *tri_chunk;      /* per triangle: its chunk */
+    dvec3 *tri_normal;   /* per triangle: (t1 - t0) x (t2 - t0), world */
+    int8_t *tri_light_side; /* per triangle: which side of its plane the light's ball lies on (exact_soft.c) */
+    int *chunk_object;   /* per chunk: its object */
+    /* Possible silhouette edges of the light's ball (exact_for_silhouette):
+     * undirected edges of the welded casters (equal positions, -0 = +0,
+     * across objects), each an entry (its side count, then each side 3 t + k
+     * of a triangle t that traverses it from corner k to k + 1, and t's
+     * chunk) listed under each chunk of its triangles, with its sphere. */
+    int num_edges;       /* all welded edges */
+    long *chunk_edges;   /* per chunk: the offset of its entries in listing; num_chunks + 1 */
+    int *listing;
+    Ball *edge_ball;
 } ExactCasters;
 
 /* Checks the sample parameters, acquires the casters' BVH and their
- * silhouette resource (for each object's closedness) and gathers them. */
-bool exact_casters_init(const TechContext *ctx, ExactCasters *c, Error *err);
+ * silhouette resource (for each object's closedness) and gathers them, with
+ * the possible silhouette edges of exact_for_silhouette if `edges`. */
+bool exact_casters_init(const TechContext *ctx, bool edges, ExactCasters *c, Error *err);
 void exact_casters_free(ExactCasters *c);
 
 /* The normalised light frame at org. */
@@ -82,6 +97,14 @@ static inline P2 exact_project(const Frame *f, dvec3 d)
 /* Twice the signed area of (a, b, p): > 0 with p left of a -> b. */
 static inline double exact_orient(P2 a, P2 b, P2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }
 
+/* A cone about the frame's c from org: its half-angle t's cosine and sine. */
+typedef struct Cone {
+    double cos_t, sin_t;
+} Cone;
+#define EXACT_CONE_MARGIN 1e-9 /* radians the casters' culls widen a cone by */
+/* The cone of half-angle acos(cos_cone) + margin (at most pi). */
+Cone exact_cone(double cos_cone, double margin);
+
 /* One view sample's light samples. */
 typedef struct LightPoints {
     vec3 org;                          /* ray origin, world */
@@ -93,6 +116,7 @@ typedef struct LightPoints {
     bool above[EXACT_MAX_SAMPLES];     /* kept */
     P2 lo, hi;                         /* bounds of the kept projections */
     double cos_cone;                   /* the kept directions' least cosine to c */
+    Cone cone;                         /* theirs, widened by EXACT_CONE_MARGIN: the casters' culls */
 } LightPoints;
 
 /* The frame and the light's bounding sphere for view sample s; false when
@@ -128,6 +152,59 @@ bool exact_front_faces_suffice(const ExactCasters *c, int o, const LightPoints *
  * corner, so both triangles of an edge clip it alike): up to 4 corners, 0
  * when nothing is left. *facing: +1 front-facing from org, -1 back-facing,
  * 0 edge-on. */
-int exact_clip(const Frame *f, const vec3 *t, dvec3 poly[4], int *facing);
+int exact_clip(const Frame *f, const vec3 *t, dvec3 poly[4], int *facing, int edge_of[4]);
+
+/* The lexicographic order of an edge's endpoints (relative to org) that the
+ * crossing predicates run on, so the two triangles of an edge evaluate them
+ * alike: true when a -> b had to be swapped into it. */
+static inline bool exact_canonical(dvec3 *a, dvec3 *b)
+{
+    bool swap = a->x > b->x || (a->x == b->x && (a->y > b->y || (a->y == b->y && a->z > b->z)));
+    if (swap) {
+        dvec3 t = *a;
+        *a = *b;
+        *b = t;
+    }
+    return swap;
+}
+
+/* The edges that step a depth-complexity count from org (Laine et al.
+ * 2005 §4, "Soft shadow volumes for ray tracing": the silhouette edges from
+ * the point to be shaded that overlap the light, found in two stages). Stage
+ * one, once per light (exact_casters_init): the possible silhouette edges of
+ * the light's bounding ball, every edge except a consistently oriented edge
+ * of two triangles that both have the whole ball strictly on one side and
+ * the same side (then from no light point is it a silhouette), each with
+ * its bounding sphere, listed under the chunks of their triangles (where the
+ * paper bins them in a hemicube about the light, the chunks' and the edges'
+ * spheres are culled against the cone from org to the light, which is the
+ * wedge test seen from org: an edge's wedge holds org iff the edge meets
+ * that cone). Stage two, per org: the listed edges of the chunks that reach
+ * the cone whose spheres reach it too (widened by EDGE_CONE_MARGIN, so
+ * neither the counts nor near_edge lose anything), each summed over its
+ * triangles as exact_for_casters visits them
+ * (culling, facing from org, front_only, the clip to d.c >= EXACT_CLIP_EPS
+ * from the inside corner, canonical order), and fn called with the sum where
+ * it is not 0; also fn for each visited clipped triangle's edge along the
+ * clip plane (its own). An edge left out in stage one never crosses a
+ * segment between two light samples' projections: from org it is no
+ * silhouette (both triangles culled, or cancelling), or one of its planes
+ * has org and the light strictly on one side, so no line from org through
+ * the edge meets the light before it (geometry beyond the light, which the
+ * techniques assume away, is the exception). So the counts are those of
+ * visiting every triangle's edges, bit for bit (tests/unit/test_exact_soft.c). */
+typedef void (*ExactEdgeFn)(void *user, dvec3 a, dvec3 b, int weight);
+
+/* One thread's scratch for exact_for_silhouette: 5 bytes per caster triangle. */
+typedef struct ExactScratch {
+    uint8_t *reached; /* per chunk: it reaches the cone; per object: 0 no, 1 yes, 2 yes and front faces suffice */
+    uint32_t org;     /* the current org's stamp */
+    uint32_t *stamp;  /* per triangle: the org its weight was found for */
+    int8_t *weight;   /* per triangle: its weight from that org */
+} ExactScratch;
+
+bool exact_scratch_init(ExactScratch *sc, const ExactCasters *c);
+void exact_scratch_free(ExactScratch *sc);
+void exact_for_silhouette(const ExactCasters *c, const LightPoints *lp, ExactScratch *sc, ExactEdgeFn fn, void *user);
 
 #endif

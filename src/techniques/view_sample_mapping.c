@@ -40,6 +40,10 @@
  * core; 4096^2 at 256 samples is accepted, at 1024 refused). */
 #define MAX_SAMPLE_TESTS 8589934592.0
 #define WORDS (EXACT_MAX_SAMPLES / 64)
+#define GRID 16 /* sample grid cells per side */
+/* normalised-frame distance a triangle's bounds are widened by: a sample
+ * within EXACT_AMBIGUOUS_TAN of an edge is near it (hide_samples) */
+#define NEAR_PAD (2.0 * EXACT_AMBIGUOUS_TAN)
 
 static const ParamDesc vsm_params[] = {
     EXACT_SAMPLE_PARAMS(32, 256,
@@ -57,6 +61,13 @@ typedef struct Mapped {
     int open;        /* kept light samples no triangle hides yet: 0 ends the mapping onto it (umbra) */
     LightPoints lp;
     uint64_t blocked[WORDS], near[WORDS];
+    /* The kept samples binned in a GRID x GRID grid over their bounds lo..hi
+     * (normalised light frame), so a triangle tests only the samples of the
+     * cells its projected bounds overlap: cell c holds cell_sample[cell_first[c]
+     * .. cell_first[c + 1]). */
+    double scale_x, scale_y; /* cells per normalised-frame unit (0 when the bounds are flat) */
+    int cell_first[GRID * GRID + 1];
+    int cell_sample[EXACT_MAX_SAMPLES];
 } Mapped;
 
 typedef struct VsmState {
@@ -64,42 +75,73 @@ typedef struct VsmState {
     float *near; /* per view sample: light samples within EXACT_AMBIGUOUS_TAN of a projected edge */
 } VsmState;
 
-/* The light samples inside the clipped, projected polygon q[0..np): the AND
- * of its edges' masks (each the samples strictly on the inner side), ORed
- * into the view sample's bitmask; samples on an edge within the tolerance
- * are marked near. */
-static void hide_samples(Mapped *m, const P2 *q, int np, double orientation)
+static int cell_of(double x, double lo, double scale)
+{
+    double c = (x - lo) * scale;
+    return c < 0.0 ? 0 : c >= GRID - 1 ? GRID - 1 : (int)c;
+}
+
+/* Bins the kept samples (a counting sort by cell). */
+static void bin_samples(Mapped *m)
 {
     const LightPoints *lp = &m->lp;
-    uint64_t inside[WORDS];
-    int words = (lp->n + 63) / 64;
-    memset(inside, 0xff, sizeof inside);
-    for (int e = 0; e < np; e++) {
-        P2 a = q[e], b = q[(e + 1) % np];
-        double len = hypot(b.x - a.x, b.y - a.y);
-        uint64_t mask[WORDS] = {0};
-        for (int i = 0; i < lp->n; i++) {
-            if (!lp->above[i] || (m->blocked[i / 64] >> (i % 64) & 1)) continue; /* left out, or hidden already */
-            double o = exact_orient(a, b, lp->x[i]) * orientation; /* > 0: the inner side */
-            if (o > 0.0) mask[i / 64] |= 1ull << (i % 64);
-            if (fabs(o) <= EXACT_AMBIGUOUS_TAN * len) {
-                double t = ((lp->x[i].x - a.x) * (b.x - a.x) + (lp->x[i].y - a.y) * (b.y - a.y)) / (len * len);
-                if (t >= 0.0 && t <= 1.0) m->near[i / 64] |= 1ull << (i % 64);
+    double wx = lp->hi.x - lp->lo.x, wy = lp->hi.y - lp->lo.y;
+    m->scale_x = wx > 0.0 ? GRID / wx : 0.0;
+    m->scale_y = wy > 0.0 ? GRID / wy : 0.0;
+    int cell[EXACT_MAX_SAMPLES];
+    memset(m->cell_first, 0, sizeof m->cell_first);
+    for (int i = 0; i < lp->n; i++) {
+        if (!lp->above[i]) continue;
+        cell[i] = cell_of(lp->x[i].y, lp->lo.y, m->scale_y) * GRID + cell_of(lp->x[i].x, lp->lo.x, m->scale_x);
+        m->cell_first[cell[i] + 1]++;
+    }
+    for (int c = 0; c < GRID * GRID; c++) m->cell_first[c + 1] += m->cell_first[c];
+    int fill[GRID * GRID] = {0};
+    for (int i = 0; i < lp->n; i++)
+        if (lp->above[i]) m->cell_sample[m->cell_first[cell[i]] + fill[cell[i]]++] = i;
+}
+
+/* The light samples inside the clipped, projected polygon q[0..np) (bounds
+ * lo..hi): those strictly on the inner side of every edge, ORed into the
+ * view sample's bitmask; samples on an edge within the tolerance are marked
+ * near. Only the samples of the grid cells the bounds (widened by NEAR_PAD)
+ * overlap are tested: one outside is outside the polygon and farther than
+ * the tolerance from its edges, so the masks are those of testing every
+ * sample. */
+static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 lo, P2 hi)
+{
+    const LightPoints *lp = &m->lp;
+    double len[4];
+    for (int e = 0; e < np; e++) len[e] = hypot(q[(e + 1) % np].x - q[e].x, q[(e + 1) % np].y - q[e].y);
+    int x0 = cell_of(lo.x - NEAR_PAD, lp->lo.x, m->scale_x), x1 = cell_of(hi.x + NEAR_PAD, lp->lo.x, m->scale_x);
+    int y0 = cell_of(lo.y - NEAR_PAD, lp->lo.y, m->scale_y), y1 = cell_of(hi.y + NEAR_PAD, lp->lo.y, m->scale_y);
+    for (int cy = y0; cy <= y1; cy++)
+        for (int k = m->cell_first[cy * GRID + x0]; k < m->cell_first[cy * GRID + x1 + 1]; k++) {
+            int i = m->cell_sample[k];
+            uint64_t bit = 1ull << (i % 64);
+            if (m->blocked[i / 64] & bit) continue; /* hidden already */
+            bool inside = true;
+            for (int e = 0; e < np; e++) {
+                P2 a = q[e], b = q[(e + 1) % np];
+                double o = exact_orient(a, b, lp->x[i]) * orientation; /* > 0: the inner side */
+                inside &= o > 0.0;
+                if (fabs(o) <= EXACT_AMBIGUOUS_TAN * len[e]) {
+                    double t = ((lp->x[i].x - a.x) * (b.x - a.x) + (lp->x[i].y - a.y) * (b.y - a.y)) /
+                               (len[e] * len[e]);
+                    if (t >= 0.0 && t <= 1.0) m->near[i / 64] |= bit;
+                }
             }
+            if (!inside) continue;
+            m->blocked[i / 64] |= bit;
+            m->open--;
         }
-        for (int w = 0; w < words; w++) inside[w] &= mask[w];
-    }
-    for (int w = 0; w < words; w++) {
-        m->open -= __builtin_popcountll(inside[w] & ~m->blocked[w]);
-        m->blocked[w] |= inside[w];
-    }
 }
 
 /* Triangle t backprojected from view sample m into its light frame. */
 static void map_triangle(Mapped *m, const vec3 *tri, bool front_only)
 {
     dvec3 poly[4];
-    int facing, np = exact_clip(&m->lp.f, tri, poly, &facing);
+    int facing, np = exact_clip(&m->lp.f, tri, poly, &facing, NULL);
     if (np < 3 || facing == 0) return; /* nothing in front, or edge-on: it hides no sample */
     if (front_only && facing < 0) return; /* a front face of the closed object hides the same samples */
     P2 q[4];
@@ -114,7 +156,7 @@ static void map_triangle(Mapped *m, const vec3 *tri, bool front_only)
     if (hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y) return; /* misses every sample */
     for (int k = 1; k + 1 < np; k++) area += exact_orient(q[0], q[k], q[k + 1]);
     if (area == 0.0) return;
-    hide_samples(m, q, np, area > 0.0 ? 1.0 : -1.0);
+    hide_samples(m, q, np, area > 0.0 ? 1.0 : -1.0, lo, hi);
 }
 
 /* Kept light samples whose bit in mask is `set`. */
@@ -133,7 +175,10 @@ static void map_tile(const ExactCasters *cs, const TechContext *ctx, Mapped *til
         memset(m->blocked, 0, sizeof m->blocked);
         memset(m->near, 0, sizeof m->near);
         m->reached = exact_begin(cs, ctx, m->s, &m->lp);
-        if (m->reached) exact_draw(&m->lp, ctx, m->s);
+        if (m->reached) {
+            exact_draw(&m->lp, ctx, m->s);
+            bin_samples(m);
+        }
         m->open = m->reached ? m->lp.kept : 0;
     }
     bool in[TILE], front_only[TILE];
@@ -198,7 +243,7 @@ static bool vsm_prepare(const TechContext *ctx, void **state, Error *err)
                               "bound of %.3g mask bits per frame; lower -p samples or the image size",
                          lit, (int)ctx->params[EXACT_P_SAMPLES], tests, MAX_SAMPLE_TESTS);
     ExactCasters cs;
-    if (!exact_casters_init(ctx, &cs, err)) return false;
+    if (!exact_casters_init(ctx, false, &cs, err)) return false;
     VsmState *st = calloc(1, sizeof *st);
     bool ok = st && (st->vis = malloc(sizeof *st->vis * (size_t)ctx->vs->count)) &&
               (st->near = malloc(sizeof *st->near * (size_t)ctx->vs->count));
