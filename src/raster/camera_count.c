@@ -187,35 +187,71 @@ static bool pairs_push(Pairs *p, int32_t sample, int32_t item)
     return true;
 }
 
-/* Render one polygon into the zeroed counters `hit`, then move its texels
- * from `hit` (zeroing them again) into the pairs. */
-static bool list_polygon(CameraCount *cc, const vec3 *v, int n, int32_t id, const RasterOptions *opt, int32_t *hit,
-                         Pairs *pairs, RasterStats *stats, Error *err)
+/* Whether the polygon turns clockwise on the grid (its projection's signed
+ * area, vertices in front of the camera; false when one is not). */
+static bool clockwise_on_grid(const CameraCount *cc, const vec3 *v, int n)
 {
-    uint32_t idx[3 * (CAMERA_POLY_MAX - 2)];
-    for (int k = 0; k + 2 < n; k++) {
-        idx[3 * k] = 0;
-        idx[3 * k + 1] = (uint32_t)k + 1;
-        idx[3 * k + 2] = (uint32_t)k + 2;
+    const mat4 *M = &cc->view.clip_from_world;
+    double x[CAMERA_POLY_MAX], y[CAMERA_POLY_MAX], area = 0.0;
+    for (int k = 0; k < n; k++) {
+        double c[4] = {0.0, 0.0, 0.0, 0.0}, p[4] = {v[k].x, v[k].y, v[k].z, 1.0};
+        for (int i = 0; i < 4; i++)
+            for (int j = 0; j < 4; j++) c[i] += M->m[i][j] * p[j];
+        if (!(c[3] > 0.0)) return false;
+        x[k] = c[0] / c[3];
+        y[k] = c[1] / c[3];
     }
-    RasterMesh mesh = {v, idx, n, n - 2};
+    for (int k = 0; k < n; k++) area += x[k] * y[(k + 1) % n] - x[(k + 1) % n] * y[k];
+    return area < 0.0;
+}
+
+/* Polygons drawn per render: polygon k of a batch adds 2^k (RasterMeshExtra
+ * counts are int16), so a texel's counter holds the set of the batch's
+ * polygons covering it (each covers a texel centre at most once, the
+ * rasterizer's top-left rule, and is drawn counter-clockwise). */
+#define LIST_BATCH 15
+
+/* Render polygons first[0 .. n) into the zeroed counters `hit`, then move
+ * each one's texels from `hit` (clearing its bit) into the pairs. */
+static bool list_batch(CameraCount *cc, const vec3 *verts, const int *first, int n, int32_t id0,
+                       const RasterOptions *opt, int32_t *hit, Pairs *pairs, RasterStats *stats, Error *err)
+{
+    uint32_t idx[3 * LIST_BATCH * (CAMERA_POLY_MAX - 2)];
+    int16_t bit[LIST_BATCH * (CAMERA_POLY_MAX - 2)];
+    int nt = 0, v0 = first[0];
+    for (int k = 0; k < n; k++) {
+        int ccw = clockwise_on_grid(cc, verts + first[k], first[k + 1] - first[k]) ? 0 : 1;
+        for (int j = first[k] + 1; j + 1 < first[k + 1]; j++, nt++) {
+            idx[3 * nt] = (uint32_t)(first[k] - v0);
+            idx[3 * nt + 1] = (uint32_t)(j + 1 - ccw - v0);
+            idx[3 * nt + 2] = (uint32_t)(j + ccw - v0);
+            bit[nt] = (int16_t)(1 << k);
+        }
+    }
+    RasterMesh mesh = {verts + v0, idx, first[n] - v0, nt};
+    RasterMeshExtra extra = {NULL, bit};
+    RasterOptions o = *opt;
+    o.extra = &extra;
     RasterStats st;
-    if (!raster_depth(&mesh, 1, &cc->view, opt, &cc->db, &st, err)) return false;
+    if (!raster_depth(&mesh, 1, &cc->view, &o, &cc->db, &st, err)) return false;
     stats->triangles_in += st.triangles_in;
     stats->triangles_clipped += st.triangles_clipped;
     stats->triangles_drawn += st.triangles_drawn;
     stats->texels_written += st.texels_written;
-    if (st.texels_written == 0) return true;
-    int box[4];
-    texel_box(cc, v, n, box);
-    for (int j = box[1]; j <= box[3]; j++)
-        for (int i = box[0]; i <= box[2]; i++) {
-            size_t t = (size_t)j * (size_t)cc->width + (size_t)i;
-            if (hit[t] == 0) continue;
-            hit[t] = 0;
-            if (!pairs_push(pairs, (cc->height - 1 - j) * cc->width + i, id))
-                return error_set(err, "out of memory for %ld camera-list entries", pairs->n);
-        }
+    for (int k = 0; k < n && st.texels_written > 0; k++) {
+        if (first[k + 1] == first[k]) continue;
+        int box[4];
+        int32_t b = 1 << k;
+        texel_box(cc, verts + first[k], first[k + 1] - first[k], box);
+        for (int j = box[1]; j <= box[3]; j++)
+            for (int i = box[0]; i <= box[2]; i++) {
+                size_t t = (size_t)j * (size_t)cc->width + (size_t)i;
+                if (!(hit[t] & b)) continue;
+                hit[t] &= ~b;
+                if (!pairs_push(pairs, (cc->height - 1 - j) * cc->width + i, id0 + k))
+                    return error_set(err, "out of memory for %ld camera-list entries", pairs->n);
+            }
+    }
     return true;
 }
 
@@ -242,11 +278,12 @@ bool camera_count_lists(CameraCount *cc, const vec3 *verts, const int *first, in
     bool ok = true;
     for (int i = 0; ok && i < num_polys; i++) {
         int n = first[i + 1] - first[i];
-        if (n < 3 || n > CAMERA_POLY_MAX) {
-            ok = n == 0 || error_set(err, "camera lists: polygon %d has %d vertices (3 to %d)", i, n, CAMERA_POLY_MAX);
-            continue;
-        }
-        ok = list_polygon(cc, verts + first[i], n, i, &opt, hit, &pairs, stats, err);
+        if (n != 0 && (n < 3 || n > CAMERA_POLY_MAX))
+            ok = error_set(err, "camera lists: polygon %d has %d vertices (0, or 3 to %d)", i, n, CAMERA_POLY_MAX);
+    }
+    for (int i = 0; ok && i < num_polys; i += LIST_BATCH) {
+        int n = num_polys - i < LIST_BATCH ? num_polys - i : LIST_BATCH;
+        ok = list_batch(cc, verts, first + i, n, i, &opt, hit, &pairs, stats, err);
     }
     /* counting sort by sample, stable: the pairs come in item order */
     out->item = ok ? malloc(sizeof *out->item * (size_t)(pairs.n ? pairs.n : 1)) : NULL;

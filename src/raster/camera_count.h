@@ -70,8 +70,10 @@ typedef struct CameraLists {
 #define CAMERA_POLY_MAX 32 /* vertices of a stand-in polygon (camera_count_stand_in) */
 
 /* Draw polygons i = 0 .. num_polys-1, polygon i being the convex fan
- * verts[first[i] .. first[i+1]) (world space, 3 to CAMERA_POLY_MAX
- * vertices), into per-sample lists. */
+ * verts[first[i] .. first[i+1]) (world space, 0 (nothing), or 3 to
+ * CAMERA_POLY_MAX vertices, either turn, in front of the camera), into
+ * per-sample lists; several share one render, each polygon adding its own
+ * bit to the texels' counters. */
 bool camera_count_lists(CameraCount *cc, const vec3 *verts, const int *first, int num_polys, CountTest test,
                         CameraLists *out, RasterStats *stats, Error *err);
 void camera_lists_free(CameraLists *l);

@@ -516,6 +516,56 @@ static bool patch_wedges(const TechContext *ctx, const SsvState *st, CameraCount
     return ok;
 }
 
+/* Whether the mesh lies in one plane: every vertex within 1e-6 of its
+ * extent of the plane of its largest triangle. */
+static bool mesh_is_flat(const Mesh *m)
+{
+    dvec3 n = d3(0, 0, 0), o = d3(0, 0, 0), lo = d3(INFINITY, INFINITY, INFINITY), hi = d3(-INFINITY, -INFINITY, -INFINITY);
+    double best = 0.0;
+    for (int t = 0; t < m->num_triangles; t++) {
+        const uint32_t *ix = &m->indices[3 * t];
+        dvec3 a = d3_from(m->positions[ix[0]]), b = d3_from(m->positions[ix[1]]), c = d3_from(m->positions[ix[2]]);
+        dvec3 x = d3_cross(d3_sub(b, a), d3_sub(c, a));
+        if (d3_dot(x, x) > best) best = d3_dot(x, x), n = x, o = a;
+    }
+    if (!(best > 0.0)) return true; /* no area: casts nothing */
+    n = d3_scale(n, 1.0 / sqrt(best));
+    for (int v = 0; v < m->num_vertices; v++) {
+        dvec3 p = d3_from(m->positions[v]);
+        lo = d3(p.x < lo.x ? p.x : lo.x, p.y < lo.y ? p.y : lo.y, p.z < lo.z ? p.z : lo.z);
+        hi = d3(p.x > hi.x ? p.x : hi.x, p.y > hi.y ? p.y : hi.y, p.z > hi.z ? p.z : hi.z);
+    }
+    double tol = 1e-6 * d3_len(d3_sub(hi, lo));
+    for (int v = 0; v < m->num_vertices; v++)
+        if (!(fabs(d3_dot(d3_sub(d3_from(m->positions[v]), o), n)) <= tol)) return false; /* NaN: not flat */
+    return true;
+}
+
+/* Open meshes (issue 14): the coverage integrates the hard volume's count,
+ * which counts every layer a ray crosses. Closed objects and shells count
+ * once (their dark side, SIL_SHELLS_DARK_SIDE); an object that took
+ * Bergeron's rule (a triangle weighted +1, counted from its front) counts
+ * once only if flat (a quad, a disk: one layer), and is refused otherwise:
+ * a ray through two of its layers would count twice (measured on a box
+ * without one face: penumbra MAE 0.17 against 0.012 for a square). */
+static bool check_layers(const Scene *scene, const Silhouette *sil, Error *err)
+{
+    for (int i = 0; i < sil->num_objects; i++) {
+        const SilObject *so = &sil->objects[i];
+        bool bergeron = false;
+        for (int t = 0; t < so->triangles && !bergeron; t++) bergeron = so->weight[t] > 0;
+        const Object *o = &scene->objects[so->object];
+        if (so->closed || !bergeron || mesh_is_flat(&o->mesh)) continue;
+        return error_set(err,
+                         "caster '%s' is neither closed (%ld open, %ld non-manifold, %ld misoriented of %ld edges), "
+                         "a shell (open edges under 1/%d, no other defect) nor flat: the wedges would count a ray "
+                         "through two of its layers twice (Bergeron's rule); close it or use shadow_volume",
+                         o->name, so->open_edges, so->nonmanifold_edges, so->misoriented_edges, so->edges,
+                         SIL_SHELL_OPEN);
+    }
+    return true;
+}
+
 static bool ssv_prepare_term(const TechContext *ctx, void **state, int term, Error *err)
 {
     const char *name = term == TERM_EXACT ? "soft_shadow_volume" : "penumbra_wedge";
@@ -544,7 +594,7 @@ static bool ssv_prepare_term(const TechContext *ctx, void **state, int term, Err
         pa->sil = res_silhouette_point(ctx->rm, ctx->scene, L, SIL_SHELLS_DARK_SIDE, desc, err);
         pa->count = malloc(sizeof *pa->count * (size_t)(ctx->vs->count + 1));
         if (!pa->count) error_set(err, "%s: out of memory for %d counts", name, ctx->vs->count);
-        if (!pa->sil || !pa->count ||
+        if (!pa->sil || !check_layers(ctx->scene, pa->sil, err) || !pa->count ||
             !shadow_volume_zfail_counts(ctx, pa->sil, ctx->params[SSV_OFFSET], pa->count, &fill, err) ||
             (!all_edges_mode && !patch_wedges(ctx, st, &cc, pa, err))) {
             st->num_patches = i + 1;
