@@ -516,8 +516,9 @@ static bool patch_wedges(const TechContext *ctx, const SsvState *st, CameraCount
     return ok;
 }
 
-/* Whether the mesh lies in one plane: every vertex within 1e-6 of its
- * extent of the plane of its largest triangle. */
+/* Whether the mesh's triangles with area lie in one plane: their corners
+ * within 1e-6 of the mesh's extent of the plane of its largest triangle
+ * (zero-area triangles cast nothing and are skipped, as by silhouette.h). */
 static bool mesh_is_flat(const Mesh *m)
 {
     dvec3 n = d3(0, 0, 0), o = d3(0, 0, 0), lo = d3(INFINITY, INFINITY, INFINITY), hi = d3(-INFINITY, -INFINITY, -INFINITY);
@@ -527,17 +528,23 @@ static bool mesh_is_flat(const Mesh *m)
         dvec3 a = d3_from(m->positions[ix[0]]), b = d3_from(m->positions[ix[1]]), c = d3_from(m->positions[ix[2]]);
         dvec3 x = d3_cross(d3_sub(b, a), d3_sub(c, a));
         if (d3_dot(x, x) > best) best = d3_dot(x, x), n = x, o = a;
+        for (int k = 0; k < 3; k++) {
+            dvec3 p = d3_from(m->positions[ix[k]]);
+            lo = d3(p.x < lo.x ? p.x : lo.x, p.y < lo.y ? p.y : lo.y, p.z < lo.z ? p.z : lo.z);
+            hi = d3(p.x > hi.x ? p.x : hi.x, p.y > hi.y ? p.y : hi.y, p.z > hi.z ? p.z : hi.z);
+        }
     }
     if (!(best > 0.0)) return true; /* no area: casts nothing */
     n = d3_scale(n, 1.0 / sqrt(best));
-    for (int v = 0; v < m->num_vertices; v++) {
-        dvec3 p = d3_from(m->positions[v]);
-        lo = d3(p.x < lo.x ? p.x : lo.x, p.y < lo.y ? p.y : lo.y, p.z < lo.z ? p.z : lo.z);
-        hi = d3(p.x > hi.x ? p.x : hi.x, p.y > hi.y ? p.y : hi.y, p.z > hi.z ? p.z : hi.z);
-    }
     double tol = 1e-6 * d3_len(d3_sub(hi, lo));
-    for (int v = 0; v < m->num_vertices; v++)
-        if (!(fabs(d3_dot(d3_sub(d3_from(m->positions[v]), o), n)) <= tol)) return false; /* NaN: not flat */
+    for (int t = 0; t < m->num_triangles; t++) {
+        const uint32_t *ix = &m->indices[3 * t];
+        dvec3 a = d3_from(m->positions[ix[0]]), b = d3_from(m->positions[ix[1]]), c = d3_from(m->positions[ix[2]]);
+        dvec3 x = d3_cross(d3_sub(b, a), d3_sub(c, a));
+        if (d3_dot(x, x) == 0.0) continue;
+        for (int k = 0; k < 3; k++) /* NaN: not flat */
+            if (!(fabs(d3_dot(d3_sub(d3_from(m->positions[ix[k]]), o), n)) <= tol)) return false;
+    }
     return true;
 }
 
