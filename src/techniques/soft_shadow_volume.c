@@ -49,7 +49,9 @@
  * its listed edges, in edge order, after the same per-sample bounding cone
  * (edge_may_meet) as an all-edges loop, so the sum is the all-edges loop's
  * bit for bit. A wedge reaching the camera's near plane has no bounded
- * projection and is evaluated at every sample. */
+ * projection and is evaluated at every sample. Measured at 160x120 on the
+ * bunny (test_soft_volumes, load 4, 2 threads): frame 0.30 s against 0.83 s
+ * for the all-edges loop, evaluation 0.066 s against 0.72 s. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
