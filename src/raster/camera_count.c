@@ -172,14 +172,17 @@ typedef struct Pairs {
     long n, cap;
 } Pairs;
 
-static bool pairs_push(Pairs *p, int32_t sample, int32_t item)
+static bool pairs_push(Pairs *p, int32_t sample, int32_t item, Error *err)
 {
+    if (p->n == CAMERA_LISTS_MAX)
+        return error_set(err, "camera lists: over %ld entries (%ld MiB): fewer view samples or casters' edges",
+                         (long)CAMERA_LISTS_MAX, (long)(CAMERA_LISTS_MAX * 12 >> 20));
     if (p->n == p->cap) {
         long cap = p->cap ? 2 * p->cap : 4096;
         int32_t *s = realloc(p->sample, sizeof *s * (size_t)cap);
         if (s) p->sample = s;
         int32_t *i = s ? realloc(p->item, sizeof *i * (size_t)cap) : NULL;
-        if (!i) return false;
+        if (!i) return error_set(err, "out of memory for %ld camera-list entries", cap);
         p->item = i;
         p->cap = cap;
     }
@@ -249,8 +252,7 @@ static bool list_batch(CameraCount *cc, const vec3 *verts, const int *first, int
                 size_t t = (size_t)j * (size_t)cc->width + (size_t)i;
                 if (!(hit[t] & b)) continue;
                 hit[t] &= ~b;
-                if (!pairs_push(pairs, (cc->height - 1 - j) * cc->width + i, id0 + k))
-                    return error_set(err, "out of memory for %ld camera-list entries", pairs->n);
+                if (!pairs_push(pairs, (cc->height - 1 - j) * cc->width + i, id0 + k, err)) return false;
             }
     }
     return true;

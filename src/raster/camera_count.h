@@ -67,6 +67,9 @@ typedef struct CameraLists {
     int32_t *item;   /* polygon indices, ascending within each sample */
 } CameraLists;
 
+/* Entries over all samples (12 bytes each while built): past it the lists
+ * fail with an error instead of taking the machine's memory. */
+#define CAMERA_LISTS_MAX (1L << 27)
 #define CAMERA_POLY_MAX 32 /* vertices of a stand-in polygon (camera_count_stand_in) */
 
 /* Draw polygons i = 0 .. num_polys-1, polygon i being the convex fan
