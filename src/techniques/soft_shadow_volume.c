@@ -38,19 +38,30 @@
  * each patch its own centre silhouette, which shortens the edges' reach and
  * the popping when a centre silhouette changes.
  *
- * Cost: each sample tests every silhouette edge of each patch against the
- * edge's wedge (a bounding cone, edge_may_meet) instead of rasterising the
- * wedges from the camera as the paper's GPU pass does, so evaluation is
- * O(samples x edges x patches): at 160x120 on one core 0.03 s on
- * sphere-on-plane, 0.7-1.4 s on the bunny (the 1024-sample reference: 1.1 s). */
+ * Wedges from the camera (Assarsson & Akenine-Möller 2003: each wedge is
+ * rasterised and only the pixels inside it run the coverage): a sample p
+ * needs edge a-b only if some segment from a point y of the light's region
+ * Y to p crosses the edge (p = y + t (q - y), q on the edge, t >= 1), so the
+ * wedge lies in conv(a, b) + cone(a - x_i, b - x_i) over the corners x_i of
+ * a box holding Y. That polyhedron's stand-in (camera_count_stand_in: its
+ * projected hull at its nearest depth) is drawn from the camera into
+ * per-sample lists (camera_count_lists), and each sample sums the terms of
+ * its listed edges, in edge order, after the same per-sample bounding cone
+ * (edge_may_meet) as an all-edges loop, so the sum is the all-edges loop's
+ * bit for bit. A wedge reaching the camera's near plane has no bounded
+ * projection and is evaluated at every sample. Measured at 160x120 on the
+ * bunny (test_soft_volumes, load 4, 2 threads): frame 0.30 s against 0.83 s
+ * for the all-edges loop, evaluation 0.066 s against 0.72 s. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/mat4.h"
 #include "core/nanmath.h"
+#include "raster/camera_count.h"
 #include "resources/silhouette.h"
 #include "techniques/shadow_volume.h"
+#include "techniques/soft_shadow_volume.h"
 #include "techniques/technique.h"
 
 enum { SSV_PATCHES, SSV_OFFSET };
@@ -79,6 +90,10 @@ typedef struct Patch {
     double area;        /* |K_i|: the cell, cut by the disk for round lights (world units^2) */
     const Silhouette *sil;
     int32_t *count;     /* w(centre) per view sample */
+    CameraLists wedges; /* per view sample, the edges whose wedge stand-in covers it */
+    int32_t *everywhere;/* edges whose wedge reaches the camera's near plane, ascending */
+    int num_everywhere;
+    bool all_edges;     /* no lists: every edge at every sample (ssv_set_all_edges) */
 } Patch;
 
 typedef struct SsvState {
@@ -91,7 +106,13 @@ typedef struct SsvState {
     int num_patches;
     Patch patch[MAX_PER_SIDE * MAX_PER_SIDE];
     double area;        /* sum of the patches' areas */
+    dvec3 corner[8];    /* a box holding the light's region Y of every patch (world) */
+    int num_corners;    /* 4 for a flat light, 8 for a sphere */
+    double trust;       /* the lists hold for samples at least this far from c0 (world units) */
 } SsvState;
+
+static bool all_edges_mode;
+void ssv_set_all_edges(bool on) { all_edges_mode = on; }
 
 /* ---- 2D geometry in the light's plane (origin: the patch centre) ------------ */
 
@@ -277,14 +298,40 @@ static void domain_at(const SsvState *st, const Patch *pa, dvec3 p, dvec3 n_p, c
     k->area = k->n >= 3 ? poly_area(k->poly, k->n, st->round, k->o, k->r) : 0.0;
 }
 
-/* A patch's covered area of K at p: w |K| plus its silhouette edges' terms. */
-static double patch_covered(const SsvState *st, const Patch *pa, int32_t w, dvec3 p, const Frame *f, const Domain *k)
+/* The edges a sample sums, ascending: its wedge list merged with the
+ * patch's `everywhere` edges, or every edge. */
+typedef struct EdgeCursor {
+    const int32_t *list, *every;
+    long n_list, n_every, i_list, i_every;
+    int all, next_all; /* all > 0: edges 0 .. all-1 */
+} EdgeCursor;
+
+static EdgeCursor edge_cursor(const Patch *pa, int s, bool all)
+{
+    if (all || pa->all_edges) return (EdgeCursor){.all = pa->sil->num_edges};
+    const CameraLists *l = &pa->wedges;
+    return (EdgeCursor){.list = l->item + l->start[s], .n_list = l->start[s + 1] - l->start[s],
+                        .every = pa->everywhere, .n_every = pa->num_everywhere};
+}
+
+static int next_edge(EdgeCursor *c)
+{
+    if (c->all) return c->next_all < c->all ? c->next_all++ : -1;
+    bool from_list = c->i_list < c->n_list, from_every = c->i_every < c->n_every;
+    if (from_list && from_every) from_list = c->list[c->i_list] < c->every[c->i_every];
+    return from_list ? c->list[c->i_list++] : from_every ? c->every[c->i_every++] : -1;
+}
+
+/* A patch's covered area of K at p: w |K| plus its silhouette edges' terms
+ * (the edges `edges` yields). */
+static double patch_covered(const SsvState *st, const Patch *pa, int32_t w, dvec3 p, const Frame *f, const Domain *k,
+                            EdgeCursor edges)
 {
     dvec3 c = pa->centre;
     double hp = d3_dot(d3_sub(p, c), f->n);
     if (!(hp > 0.0)) return w != 0 ? k->area : 0.0; /* p on the light's plane: the centre decides */
     double rb = sqrt(k->cell.x * k->cell.x + k->cell.y * k->cell.y) + sqrt(k->hx * k->hx + k->hy * k->hy), hmax = hp * (1.0 - 1e-6), a_cov = (double)w * k->area;
-    for (int i = 0; i < pa->sil->num_edges; i++) {
+    for (int i = next_edge(&edges); i >= 0; i = next_edge(&edges)) {
         const SilEdge *e = &pa->sil->edges[i];
         dvec3 a = d3_from(e->a), b = d3_from(e->b);
         if (!edge_may_meet(p, c, rb, a, b)) continue;
@@ -335,9 +382,12 @@ static double covered_fraction(const SsvState *st, const ViewSamples *vs, int s)
             area += k[i].area / (k[i].scale * k[i].scale);
         }
     }
+    bool all = !(d3_len(d3_sub(p, st->c0)) >= st->trust);
     for (int i = 0; i < st->num_patches; i++)
         if (k[i].area > 0.0)
-            covered += patch_covered(st, &st->patch[i], st->patch[i].count[s], p, &f, &k[i]) / (k[i].scale * k[i].scale);
+            covered += patch_covered(st, &st->patch[i], st->patch[i].count[s], p, &f, &k[i],
+                                     edge_cursor(&st->patch[i], s, all)) /
+                       (k[i].scale * k[i].scale);
     return covered / area; /* area > 0: light_shape refuses a light without one */
 }
 
@@ -358,8 +408,37 @@ static void ssv_release(void *state)
 {
     SsvState *st = state;
     if (!st) return;
-    for (int i = 0; i < st->num_patches; i++) free(st->patch[i].count);
+    for (int i = 0; i < st->num_patches; i++) {
+        free(st->patch[i].count);
+        camera_lists_free(&st->patch[i].wedges);
+        free(st->patch[i].everywhere);
+    }
     free(st);
+}
+
+/* The box holding the region Y the wedges are built from (see the header):
+ * the light's rectangle (a disk's square) for a flat light, where every
+ * patch's K lies. For a sphere, K is the disk facing p through c0 (radius
+ * r) projected from p onto the plane through the patch's centre c_i, which
+ * scales it about p by s = h_i / h_0 <= 1 + r / h_0 (domain_at), so with
+ * patches |y - c0| <= r + s r <= 3 r for samples at h_0 = |p - c0| >= r
+ * (the cube of half side 3 r; inside the light sphere every edge is summed),
+ * and Y is the disk itself with one patch (s = 1: the cube of half side r).
+ * The linear term (2002) needs no crossing inside K: it counts where the
+ * foot x_f of the perpendicular from c_i lies on the projected edge and
+ * |x_f - c_i| = d < e, e at most the cell's half diagonal (a flat light:
+ * within ex + ey of c0, the square of that half side) or, for a sphere,
+ * r + |o| <= 2 r about c_i (within 3 r of c0; r with one patch). */
+static void light_bound(SsvState *st, int per_side, double ex, double ey)
+{
+    double ez = st->facing ? st->radius * (per_side > 1 ? 3.0 : 1.0) : 0.0;
+    if (st->facing) ex = ey = ez;
+    else if (st->term == TERM_LINEAR) ex = ey = ex + ey;
+    st->trust = st->facing && per_side > 1 ? st->radius : 0.0;
+    st->num_corners = st->facing ? 8 : 4;
+    for (int i = 0; i < st->num_corners; i++)
+        st->corner[i] = d3_madd(d3_madd(d3_madd(st->c0, st->t0, i & 1 ? ex : -ex), st->b0, i & 2 ? ey : -ey), st->n0,
+                                i & 4 ? ez : -ez);
 }
 
 /* The light's centre, fixed frame and cells. */
@@ -397,6 +476,103 @@ static void light_shape(const TechContext *ctx, int per_side, SsvState *st)
             pa->area = poly_area(poly, n, st->round, (P2){0.0, 0.0}, st->radius);
             st->area += pa->area;
         }
+    light_bound(st, per_side, ex, ey);
+}
+
+/* Patch pa's wedge lists: each silhouette edge's stand-in drawn from the
+ * camera, or the edge in `everywhere` when it has none. */
+static bool patch_wedges(const TechContext *ctx, const SsvState *st, CameraCount *cc, Patch *pa, Error *err)
+{
+    int ne = pa->sil->num_edges;
+    vec3 *verts = malloc(sizeof *verts * (size_t)CAMERA_POLY_MAX * (size_t)(ne ? ne : 1));
+    int *first = malloc(sizeof *first * (size_t)(ne + 1));
+    pa->everywhere = malloc(sizeof *pa->everywhere * (size_t)(ne ? ne : 1));
+    if (!verts || !first || !pa->everywhere) {
+        free(verts);
+        free(first);
+        return error_set(err, "out of memory for %d wedges", ne);
+    }
+    first[0] = 0;
+    for (int i = 0; i < ne; i++) {
+        dvec3 end[2] = {d3_from(pa->sil->edges[i].a), d3_from(pa->sil->edges[i].b)};
+        double gen[2 + 2 * 8][4];
+        int m = 0;
+        for (int j = 0; j < 2; j++) {
+            gen[m][0] = end[j].x, gen[m][1] = end[j].y, gen[m][2] = end[j].z, gen[m++][3] = 1.0;
+            for (int c = 0; c < st->num_corners; c++) {
+                dvec3 d = d3_sub(end[j], st->corner[c]); /* the extrusion away from the light's corner */
+                gen[m][0] = d.x, gen[m][1] = d.y, gen[m][2] = d.z, gen[m++][3] = 0.0;
+            }
+        }
+        int n = 0;
+        if (!camera_count_stand_in(cc, &ctx->scene->camera, (const double(*)[4])gen, m, verts + first[i], &n)) {
+            pa->everywhere[pa->num_everywhere++] = i;
+            n = 0;
+        }
+        first[i + 1] = first[i] + n;
+    }
+    RasterStats fill;
+    bool ok = camera_count_lists(cc, verts, first, ne, COUNT_NEARER, &pa->wedges, &fill, err);
+    free(verts);
+    free(first);
+    return ok;
+}
+
+/* Whether the mesh's triangles with area lie in one plane: their corners
+ * within 1e-6 of the mesh's extent of the plane of its largest triangle
+ * (zero-area triangles cast nothing and are skipped, as by silhouette.h). */
+static bool mesh_is_flat(const Mesh *m)
+{
+    dvec3 n = d3(0, 0, 0), o = d3(0, 0, 0), lo = d3(INFINITY, INFINITY, INFINITY), hi = d3(-INFINITY, -INFINITY, -INFINITY);
+    double best = 0.0;
+    for (int t = 0; t < m->num_triangles; t++) {
+        const uint32_t *ix = &m->indices[3 * t];
+        dvec3 a = d3_from(m->positions[ix[0]]), b = d3_from(m->positions[ix[1]]), c = d3_from(m->positions[ix[2]]);
+        dvec3 x = d3_cross(d3_sub(b, a), d3_sub(c, a));
+        if (d3_dot(x, x) > best) best = d3_dot(x, x), n = x, o = a;
+        for (int k = 0; k < 3; k++) {
+            dvec3 p = d3_from(m->positions[ix[k]]);
+            lo = d3(p.x < lo.x ? p.x : lo.x, p.y < lo.y ? p.y : lo.y, p.z < lo.z ? p.z : lo.z);
+            hi = d3(p.x > hi.x ? p.x : hi.x, p.y > hi.y ? p.y : hi.y, p.z > hi.z ? p.z : hi.z);
+        }
+    }
+    if (!(best > 0.0)) return true; /* no area: casts nothing */
+    n = d3_scale(n, 1.0 / sqrt(best));
+    double tol = 1e-6 * d3_len(d3_sub(hi, lo));
+    for (int t = 0; t < m->num_triangles; t++) {
+        const uint32_t *ix = &m->indices[3 * t];
+        dvec3 a = d3_from(m->positions[ix[0]]), b = d3_from(m->positions[ix[1]]), c = d3_from(m->positions[ix[2]]);
+        dvec3 x = d3_cross(d3_sub(b, a), d3_sub(c, a));
+        if (d3_dot(x, x) == 0.0) continue;
+        for (int k = 0; k < 3; k++) /* NaN: not flat */
+            if (!(fabs(d3_dot(d3_sub(d3_from(m->positions[ix[k]]), o), n)) <= tol)) return false;
+    }
+    return true;
+}
+
+/* Open meshes (issue 14): the coverage integrates the hard volume's count,
+ * which counts every layer a ray crosses. Closed objects and shells count
+ * once (their dark side, SIL_SHELLS_DARK_SIDE); an object that took
+ * Bergeron's rule (a triangle weighted +1, counted from its front) counts
+ * once only if flat (a quad, a disk: one layer), and is refused otherwise:
+ * a ray through two of its layers would count twice (measured on a box
+ * without one face: penumbra MAE 0.17 against 0.012 for a square). */
+static bool check_layers(const Scene *scene, const Silhouette *sil, Error *err)
+{
+    for (int i = 0; i < sil->num_objects; i++) {
+        const SilObject *so = &sil->objects[i];
+        bool bergeron = false;
+        for (int t = 0; t < so->triangles && !bergeron; t++) bergeron = so->weight[t] > 0;
+        const Object *o = &scene->objects[so->object];
+        if (so->closed || !bergeron || mesh_is_flat(&o->mesh)) continue;
+        return error_set(err,
+                         "caster '%s' is neither closed (%ld open, %ld non-manifold, %ld misoriented of %ld edges), "
+                         "a shell (open edges under 1/%d, no other defect) nor flat: the wedges would count a ray "
+                         "through two of its layers twice (Bergeron's rule); close it or use shadow_volume",
+                         o->name, so->open_edges, so->nonmanifold_edges, so->misoriented_edges, so->edges,
+                         SIL_SHELL_OPEN);
+    }
+    return true;
 }
 
 static bool ssv_prepare_term(const TechContext *ctx, void **state, int term, Error *err)
@@ -411,8 +587,14 @@ static bool ssv_prepare_term(const TechContext *ctx, void **state, int term, Err
         free(st);
         return error_set(err, "%s: light %d has no area (radius, width or height 0)", name, ctx->light_index + 1);
     }
+    CameraCount cc = {0};
+    if (!all_edges_mode && !camera_count_init(&cc, &ctx->scene->camera, ctx->vs, ctx->vs->depth_view, err)) {
+        free(st);
+        return false;
+    }
     for (int i = 0; i < st->num_patches; i++) {
         Patch *pa = &st->patch[i];
+        pa->all_edges = all_edges_mode;
         double L[4] = {pa->centre.x, pa->centre.y, pa->centre.z, 1.0};
         char desc[160];
         snprintf(desc, sizeof desc, "casters, patch %d of %d of light %d", i + 1, st->num_patches, ctx->light_index + 1);
@@ -421,13 +603,16 @@ static bool ssv_prepare_term(const TechContext *ctx, void **state, int term, Err
         pa->sil = res_silhouette_point(ctx->rm, ctx->scene, L, SIL_SHELLS_DARK_SIDE, desc, err);
         pa->count = malloc(sizeof *pa->count * (size_t)(ctx->vs->count + 1));
         if (!pa->count) error_set(err, "%s: out of memory for %d counts", name, ctx->vs->count);
-        if (!pa->sil || !pa->count ||
-            !shadow_volume_zfail_counts(ctx, pa->sil, ctx->params[SSV_OFFSET], pa->count, &fill, err)) {
+        if (!pa->sil || !check_layers(ctx->scene, pa->sil, err) || !pa->count ||
+            !shadow_volume_zfail_counts(ctx, pa->sil, ctx->params[SSV_OFFSET], pa->count, &fill, err) ||
+            (!all_edges_mode && !patch_wedges(ctx, st, &cc, pa, err))) {
             st->num_patches = i + 1;
             ssv_release(st);
+            camera_count_free(&cc);
             return false;
         }
     }
+    camera_count_free(&cc);
     *state = st;
     return true;
 }
