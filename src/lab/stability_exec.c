@@ -328,6 +328,14 @@ static bool measure(const StabJob *j, Lab *lab, const Image *v, const uint8_t *c
     return true;
 }
 
+/* The first of the case's refusal words a message lacks, or NULL. */
+static const char *refusal_lacks(const StabCase *c, const char *msg)
+{
+    for (int w = 0; c && w < 3 && c->refusal[w]; w++)
+        if (!strstr(msg, c->refusal[w])) return c->refusal[w];
+    return NULL;
+}
+
 static void run_render(const StabJob *j, Lab *lab, StabResult *r)
 {
     double vals[TECH_MAX_PARAMS];
@@ -337,7 +345,10 @@ static void run_render(const StabJob *j, Lab *lab, StabResult *r)
     Error e = {{0}};
     bool may_refuse = (j->c && j->c->may_refuse) || j->probe == PROBE_AT_MAX;
     if (!lab_render(lab, &req, &out, &e)) {
-        if (may_refuse && e.msg[0]) {
+        const char *lacks = j->probe == PROBE_AT_MAX ? NULL : refusal_lacks(j->c, e.msg);
+        if (may_refuse && e.msg[0] && lacks) {
+            fail(r, "refusal lacks '%s': %s", lacks, e.msg);
+        } else if (may_refuse && e.msg[0]) {
             r->status = STAB_PASS;
             note(r, "refused (allowed here): %s", e.msg);
         } else {
@@ -374,11 +385,11 @@ static void run_scene_refusal(const StabJob *j, const char *path, StabResult *r)
         fail(r, "the scene was accepted");
         return;
     }
-    for (int w = 0; w < 3 && j->c->refusal[w]; w++)
-        if (!strstr(e.msg, j->c->refusal[w])) {
-            fail(r, "refusal lacks '%s': %s", j->c->refusal[w], e.msg);
-            return;
-        }
+    const char *lacks = refusal_lacks(j->c, e.msg);
+    if (lacks) {
+        fail(r, "refusal lacks '%s': %s", lacks, e.msg);
+        return;
+    }
     r->status = STAB_PASS;
     snprintf(r->detail, sizeof r->detail, "refused: %s", e.msg);
 }
