@@ -3,6 +3,7 @@
 #include "techniques/exact_soft.h"
 #include <math.h>
 #include <stdlib.h>
+#include "core/counters.h"
 #include "resources/silhouette.h"
 #include "resources/standard.h"
 
@@ -228,7 +229,7 @@ bool exact_occluded(const ExactCasters *c, vec3 org, const LightSample *ls)
     struct RTCRay ray = {.org_x = org.x, .org_y = org.y, .org_z = org.z, .tnear = 0.0f,
                          .dir_x = ls->dir_world.x, .dir_y = ls->dir_world.y, .dir_z = ls->dir_world.z,
                          .tfar = isinf(ls->dist) ? INFINITY : ls->dist * (1.0f - 1e-5f), .mask = 0xFFFFFFFFu};
-    rtcOccluded1(c->rtc, &ictx, &ray);
+    rt_occluded1(c->rtc, &ictx, &ray);
     return ray.tfar == -INFINITY;
 }
 
@@ -240,6 +241,7 @@ float exact_sliver_visibility(const ExactCasters *c, const TechContext *ctx, int
 
 int exact_clip(const Frame *f, const vec3 *t, dvec3 poly[4], int *facing)
 {
+    work_raster(1, 0); /* a triangle set up against the light frame (core/counters.h) */
     dvec3 q[3];
     double h[3];
     for (int k = 0; k < 3; k++) {

@@ -27,6 +27,7 @@
  * windows after it, as it would through a float SAT). The slices' depth
  * range is the finite depths'. */
 #include <stdlib.h>
+#include "core/counters.h"
 #include "techniques/backproject.h"
 
 enum { P_SLICES = SMAP_NUM_PARAMS };
@@ -173,6 +174,7 @@ static double box_mean(const OtState *st, int face, int k, int i0, int j0, int i
     j1 = j1 >= res ? res - 1 : j1;
     if (i0 > i1 || j0 > j1) return 0.0; /* off the face: nothing known to occlude */
     const uint32_t *s = sat_of(st, face, k);
+    work_texels(4, sizeof *s); /* the SAT's four corners (core/counters.h) */
     double count = (double)s[(size_t)(j1 + 1) * n + i1 + 1] - s[(size_t)j0 * n + i1 + 1] - s[(size_t)(j1 + 1) * n + i0] +
                    s[(size_t)j0 * n + i0];
     return count / ((double)(i1 - i0 + 1) * (j1 - j0 + 1));
