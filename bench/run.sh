@@ -55,6 +55,8 @@ run "$bin/techniques" --only constant --threads "$threads" --repeat "$repeat" -o
 # where a SAT window loses precision at large exponents) costs K^2.
 run "$bin/techniques" --only constant -t esm -p classifier=none -p exponent=20 --threads "$threads" \
     --repeat "$repeat" -o "$out"
+# machine-independent work counters beside the hand counts (160x120; exits 1 on a disagreement)
+run "$bin/techniques" --only work --threads "$threads" -o "$out"
 
 step 4 "sweep reuse"
 run "$bin/sweep_reuse" --threads "$threads" -o "$out"
