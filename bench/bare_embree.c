@@ -14,8 +14,9 @@
  * context flag INCOHERENT (Embree 3's default) or COHERENT. reference_compute
  * does everything they do. Rounds run every variant and the reference, each
  * round starting one pass later in that list (after one untimed warm-up
- * round); every round checks that each variant
- * and the reference saw the same rays and the same visibility per sample;
+ * round); every round checks that each variant and the reference saw the
+ * same rays and the same visibility per sample, and that the work counters
+ * (core/counters.h) counted the rays the reference reports;
  * the limit is the variant with the lowest median time, and the ratio the
  * median over rounds of that variant's time over the reference's. One CSV
  * row is added to reports/bench/reference_throughput.csv.
@@ -309,16 +310,27 @@ static bool run_round(const Inputs *in, const ReferenceParams *prm, int round, T
 {
     Reference ref;
     bool have_ref = false, ok = true;
+    WorkCounters w0 = {0}, w1 = {0}; /* around the reference: its rays as the work counters saw them */
     for (int i = 0; ok && i <= NUM_VARIANTS; i++) {
         int v = (round + i) % (NUM_VARIANTS + 1);
+        bool is_ref = v == NUM_VARIANTS;
+        if (is_ref) work_snapshot(&w0);
         double t0 = timer_now_s();
-        if (v == NUM_VARIANTS)
+        if (is_ref)
             ok = have_ref = reference_compute(in->casters, in->scene, in->light_index, in->vs, in->cls, prm, &ref, err);
         else ok = trace_pass(in, (Variant)v, &traces[v], err);
         double dt = timer_now_s() - t0;
-        if (v == NUM_VARIANTS) *ref_s = dt;
-        else variant_s[v] = dt;
+        if (is_ref) {
+            work_snapshot(&w1);
+            *ref_s = dt;
+        } else {
+            variant_s[v] = dt;
+        }
     }
+    WorkCounters counted = work_diff(&w1, &w0);
+    if (ok && (long long)counted.rays != ref.rays)
+        ok = error_set(err, "MISMATCH: the work counters saw %llu reference rays, the reference reports %lld",
+                       (unsigned long long)counted.rays, ref.rays);
     for (int v = 0; ok && v < NUM_VARIANTS; v++) ok = check_agreement(in, &ref, &traces[v], (Variant)v, err);
     if (have_ref) reference_free(&ref);
     return ok;
