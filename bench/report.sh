@@ -139,7 +139,9 @@ plot x with lines dashtype 2 title 'ideal'"
     fi
     echo "## 1. Reference throughput against a bare Embree loop (target ratio >= 0.9)"
     echo
-    table reference_throughput.csv scene triangles samples rays bare_rays_per_s reference_rays_per_s ratio threads load_1min commit
+    echo "bare_rays_per_s is the fastest of rtcOccluded1, 4, 8, 16 and rtcOccluded1M (incoherent, coherent), named in fastest:"
+    echo
+    table reference_throughput.csv scene triangles samples rays fastest bare_rays_per_s reference_rays_per_s ratio occluded1_rays_per_s occluded16_rays_per_s threads load_1min commit
     echo "Seed 002's overhead, single_sample_rt / hard:"
     echo
     table single_sample_overhead.csv scene radius shadow_ratio ray_tracer_ratio threads load_1min commit
@@ -164,6 +166,9 @@ plot x with lines dashtype 2 title 'ideal'"
     echo "Constant in the light's size (the prefiltered PCSS family and occlusion textures claim it; pcss grows):"
     echo
     table light_size.csv technique map_size radius_small radius_large frame_small_ms frame_large_ms ratio within scene threads load_1min
+    echo "Machine-independent work per technique (core/counters.h), beside the hand count where one is known:"
+    echo
+    table work.csv technique texel_fetches_per_sample rays_per_sample frame_triangles frame_fragments frame_bytes_built hand_rule agrees light
     echo "## 4. Sweep reuse (target <= 1.1; cached references not retraced)"
     echo
     table sweep_reuse.csv sweep technique points sweep_ms one_build_ms evals_ms ratio builds reuses within threads load_1min

@@ -18,11 +18,18 @@
  *     radius 0.05 and 0.8 (map_size 2048 where it has one; --quick: 1024):
  *     frame time at 0.8 over 0.05, against the 1.2 bound the constant-time
  *     claims name (prefiltered PCSS, CSSM, VSSM, ESSM, moment soft shadows:
- *     course §5.2.2; occlusion textures: §5.2.5), `pcss` beside them growing.
+ *     course §5.2.2; occlusion textures: §5.2.5), `pcss` beside them growing;
+ *   work: each technique's machine-independent work counters (core/counters.h:
+ *     texel fetches and rays per lit candidate, the frame's triangles, texels
+ *     rasterised, texel fetches, rays and bytes built) at 160x120, beside the
+ *     hand count where one is known: a K x K box PCF reads K^2 texels per lit
+ *     candidate, a single-layer sm one, hard and single_sample_rt trace one
+ *     ray (bench_lab_open's scene: every sample lies in the fitted map).
  * -p NAME=VALUE sets that parameter in every technique that has one (the
  * rows' `settings` column lists what was set).
- * Rows: DIR/growth.csv, DIR/constant_time.csv, DIR/threads_eval.csv, DIR/light_size.csv.
- * Usage: techniques [--only growth|constant|threads|lightsize] [-t TECH]... [-p NAME=VALUE]...
+ * Rows: DIR/growth.csv, DIR/constant_time.csv, DIR/threads_eval.csv, DIR/light_size.csv,
+ * DIR/work.csv.
+ * Usage: techniques [--only growth|constant|threads|lightsize|work] [-t TECH]... [-p NAME=VALUE]...
  *                   [--threads N] [--repeat R] [--quick] [-o DIR] [SCENE] */
 #include <math.h>
 #include <omp.h>
@@ -43,6 +50,9 @@
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup," WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
                           WHERE_HEADER
+#define WORK_HEADER "technique,lit_candidates,texel_fetches_per_sample,texel_bytes_per_sample,rays_per_sample," \
+                    "frame_triangles,frame_fragments,frame_texel_fetches,frame_rays,frame_bytes_built,hand_rule," \
+                    "hand_texel_fetches_per_sample,hand_rays_per_sample,agrees," WHERE_HEADER
 
 typedef struct Options {
     BenchCommon c;
@@ -112,7 +122,7 @@ static bool parse_options(int argc, char **argv, Options *o)
     *o = (Options){.quick = false};
     if (!bench_parse(argc, argv, 3, &o->c, own_option, o) || o->c.num_scenes > 1) return false;
     if (o->only && strcmp(o->only, "growth") != 0 && strcmp(o->only, "constant") != 0 &&
-        strcmp(o->only, "threads") != 0 && strcmp(o->only, "lightsize") != 0)
+        strcmp(o->only, "threads") != 0 && strcmp(o->only, "lightsize") != 0 && strcmp(o->only, "work") != 0)
         return false;
     for (int i = 0; i < o->num_techs; i++) {
         Error err;
@@ -453,6 +463,66 @@ static bool scaling(const Options *o, Subject *sj, Error *err)
     return ok;
 }
 
+/* ---- work counters against hand counts ------------------------------------- */
+
+/* The hand count of a technique's evaluation, per lit candidate, where its
+ * rule is known (false: none): texel fetches and rays, and the rule. */
+static bool hand_count(const Technique *t, const double *params, double *texels, double *rays, const char **rule)
+{
+    int K = tech_param_index(t, "K"), kernel = tech_param_index(t, "kernel"), layers = tech_param_index(t, "layers");
+    *texels = *rays = 0.0;
+    if (strcmp(t->name, "pcf") == 0 && K >= 0 && kernel >= 0 && params[kernel] == 0.0) { /* kernel 0: box */
+        *texels = params[K] * params[K];
+        *rule = "K x K box: K^2 texels";
+    } else if (strcmp(t->name, "sm") == 0 && (layers < 0 || params[layers] == 0.0)) { /* one layer */
+        *texels = 1.0;
+        *rule = "one texel";
+    } else if (strcmp(t->name, "hard") == 0 || strcmp(t->name, "single_sample_rt") == 0) {
+        *rays = 1.0;
+        *rule = "one ray";
+    } else {
+        return false;
+    }
+    return true;
+}
+
+static bool work_counts(const Options *o, Subject *sj, Error *err)
+{
+    static const char *const small[] = {"camera.width=160", "camera.height=120"};
+    Lab *lab = open_lab(o, sj, small, 2, err);
+    if (!lab) return false;
+    RenderRequest req = {.tech = sj->t, .params = sj->params, .light_index = 0, .repeat = 1};
+    RenderResult r;
+    bool ok = lab_render(lab, &req, &r, err);
+    if (ok) {
+        const WorkCounters *e = &r.eval_work, *f = &r.frame_work;
+        double n = r.lit_candidates > 0 ? (double)r.lit_candidates : NAN;
+        double texels = (double)e->texel_fetches / n, rays = (double)e->rays / n, hand_t, hand_r;
+        const char *rule = "";
+        bool known = hand_count(sj->t, sj->params, &hand_t, &hand_r, &rule);
+        bool agrees = known && texels == hand_t && rays == hand_r;
+        printf("%-22s %8.2f texels/sample %6.2f rays/sample | frame %9llu triangles %9llu texels rasterised "
+               "%10llu bytes built%s%s%s\n",
+               sj->t->name, texels, rays, (unsigned long long)f->triangles, (unsigned long long)f->fragments,
+               (unsigned long long)r.frame_bytes, known ? " | hand count: " : "", rule,
+               known ? (agrees ? " (agrees)" : " (DISAGREES)") : "");
+        char row[2048], tail[1024];
+        where(sj, lab_scene(lab), omp_get_max_threads(), tail, sizeof tail);
+        snprintf(row, sizeof row, "%s,%ld,%.4f,%.4f,%.4f,%llu,%llu,%llu,%llu,%zu,%s,%s%.4g,%s%.4g,%s,%s", sj->t->name,
+                 r.lit_candidates, texels, (double)e->texel_bytes / n, rays, (unsigned long long)f->triangles,
+                 (unsigned long long)f->fragments, (unsigned long long)f->texel_fetches,
+                 (unsigned long long)f->rays, r.frame_bytes, rule, "", known ? hand_t : NAN, "",
+                 known ? hand_r : NAN, known ? (agrees ? "yes" : "no") : "", tail);
+        ok = append(o, "work.csv", WORK_HEADER, row, err);
+        if (ok && known && !agrees)
+            ok = error_set(err, "work counters disagree with the hand count (%s): %.4g texels, %.4g rays per sample",
+                           rule, texels, rays);
+        render_result_free(&r);
+    }
+    lab_close(lab);
+    return ok;
+}
+
 /* ---- main ------------------------------------------------------------------ */
 
 /* The parts of one technique that --only asks for; its error printed. */
@@ -465,6 +535,7 @@ static bool bench_technique(const Options *o, const Technique *t)
     if (ok && part(o, "constant") && has_sat(t)) ok = constant_time(o, &sj, &err);
     if (ok && part(o, "threads")) ok = scaling(o, &sj, &err);
     if (ok && part(o, "lightsize") && soft_on_spheres(t)) ok = light_size(o, &sj, &err);
+    if (ok && part(o, "work")) ok = work_counts(o, &sj, &err);
     if (sj.refused) printf("%s: %d growth point(s) REFUSED (growth.csv's note column says why)\n", t->name, sj.refused);
     if (!ok) fprintf(stderr, "techniques: %s: FAILED: %s\n", t->name, err.msg);
     return ok;
@@ -474,7 +545,7 @@ int main(int argc, char **argv)
 {
     Options o;
     if (!parse_options(argc, argv, &o))
-        return bench_usage("techniques [--only growth|constant|threads|lightsize] [-t TECH]... [-p NAME=VALUE]... "
+        return bench_usage("techniques [--only growth|constant|threads|lightsize|work] [-t TECH]... [-p NAME=VALUE]... "
                            "[--threads N] [--repeat R] [--quick] [-o DIR] [SCENE]");
     omp_set_num_threads(o.c.threads);
     rt_set_threads(o.c.threads);

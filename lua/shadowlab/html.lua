@@ -317,6 +317,14 @@ function html.write_index(path, doc)
   plot_block(doc.plots.combined, out)
   for _, p in ipairs(doc.plots.time) do plot_block(p.file, out) end
   out[#out + 1] = "</div>"
+  if #doc.plots.work > 0 then
+    out[#out + 1] = "<h2>" .. esc(doc.err_label) .. " against machine-independent work</h2>" ..
+                    "<p class=\"note\">Counted, not timed (the record's <code>work</code> block): texel fetches, " ..
+                    "rays, triangles and texels rasterised, bytes built and read, per lit candidate or per frame; " ..
+                    "what a technique costs on another machine, a GPU included.</p><div class=\"plots\">"
+    for _, p in ipairs(doc.plots.work) do plot_block(p.file, out) end
+    out[#out + 1] = "</div>"
+  end
   if #doc.plots.axes > 0 then
     out[#out + 1] = "<h2>Against the swept parameters</h2><div class=\"plots\">"
     for _, p in ipairs(doc.plots.axes) do plot_block(p.file, out) end

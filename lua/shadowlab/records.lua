@@ -64,6 +64,23 @@ local function record_field(a, b)
   return function(r) return r.record and r.record[a] and r.record[a][b] end
 end
 
+-- The record's machine-independent work counters (src/lab/record.c's `work`
+-- block, core/counters.h), what reports plot error against beside time:
+-- {column name, label with its unit, path into record.work}.
+records.work_counters = {
+  { "texel_fetches_per_sample", "texel fetches per lit candidate", "per_sample", "texel_fetches" },
+  { "rays_per_sample", "rays per lit candidate", "per_sample", "rays" },
+  { "frame_texel_fetches", "texel fetches per frame", "frame", "texel_fetches" },
+  { "frame_bytes_read", "bytes read per frame (texel fetches x stored texel size)", "frame", "texel_bytes" },
+  { "frame_rays", "rays per frame", "frame", "rays" },
+  { "frame_triangles", "triangles set up per frame", "frame", "triangles" },
+  { "frame_fragments", "texels rasterised per frame", "frame", "fragments" },
+  { "frame_bytes_built", "bytes of resources built per frame", "frame", "bytes_built" },
+}
+local function work(part, field)
+  return function(r) return r.record and r.record.work and r.record.work[part] and r.record.work[part][field] end
+end
+
 records.standard_columns = {
   { "index", function(r) return r.index end },
   { "key", function(r) return r.key end },
@@ -112,6 +129,7 @@ records.standard_columns = {
   { "terminator_rmse", metric("terminator", "rmse") },
   { "false_shadow", record_field("metrics", "false_shadow") },
   { "false_lit", record_field("metrics", "false_lit") },
+  { "lit_candidates", record_field("work", "lit_candidates") },
   { "threads", record_field("machine", "threads") },
   { "host", record_field("machine", "host") },
   { "cpu", record_field("machine", "cpu") },
@@ -191,6 +209,17 @@ function records.metric_path(path)
   return nil, string.format("unknown error metric '%s'; valid: REGION.FIELD with REGION one of %s and FIELD one " ..
                             "of %s (e.g. penumbra.rmse; a bare FIELD means all.FIELD)", tostring(path),
                             table.concat(records.metric_regions, ", "), table.concat(records.metric_fields, ", "))
+end
+
+for _, c in ipairs(records.work_counters) do -- their columns, after lit_candidates, before the machine's
+  table.insert(records.standard_columns, #records.standard_columns - 5, { c[1], work(c[3], c[4]) })
+end
+-- The getter of a work counter's column (a name of records.work_counters).
+function records.work_value(name, row)
+  for _, c in ipairs(records.work_counters) do
+    if c[1] == name then return work(c[3], c[4])(row) end
+  end
+  error("records: unknown work counter " .. tostring(name), 2)
 end
 
 local standard_getter = {}

@@ -2,7 +2,9 @@
 -- network, relative links, opens from disk), results.csv and records.jsonl
 -- (written by the sweep), the images of every configuration beside the
 -- reference, and gnuplot plots in SVG and PNG: error against time with the
--- Pareto front marked, error against each swept parameter, cost against each
+-- Pareto front marked, error against each machine-independent work counter
+-- (texel fetches, rays, triangles, fragments, bytes: what transfers to
+-- another machine), error against each swept parameter, cost against each
 -- swept parameter. Every plot names its scene, resolution, reference samples
 -- and reference noise (plot.lua builds that from the rows it is given).
 local json = require "shadowlab.json"
@@ -208,14 +210,36 @@ local spread_note = "bars: fastest to slowest of the timed evaluations"
 
 local function variant_text(v) return v.scene .. (v.label ~= "" and " [" .. v.label .. "]" or "") end
 
--- Error against time, one series per technique. For one scene variant
--- (combined = false) with its Pareto front, marked on the rows and its
--- points labelled; combined, the rows of every variant, a series per
--- technique and variant, without a front (fronts compare one scene).
-local function error_vs_time(ctx, rows, name, combined)
+-- What an error plot's x axis measures: the time (ctx.time) with its
+-- spread, or one of the record's work counters (records.work_counters), a
+-- count with no spread. Rows without any of the work (0: a ray technique's
+-- texel fetches) have no place on a log axis and are left out.
+local function time_measure(ctx)
+  return { file = "time", label = time_fields[ctx.time], unit = "ms", note = spread_note, front = true,
+           x = function(rec) return time_spread(rec, ctx.time) end }
+end
+
+local function work_measure(counter)
+  local name, label = counter[1], counter[2]
+  return { file = name:gsub("_", "-"), label = label, unit = "count", front = true,
+           note = "counted, not timed (core/counters.h); rows without any left out",
+           x = function(rec)
+             local v = records.work_value(name, { record = rec })
+             if type(v) ~= "number" then return nil end
+             return v, v, v
+           end }
+end
+
+-- Error against a measure (time_measure, work_measure), one series per
+-- technique. For one scene variant (combined = false) with its Pareto
+-- front, marked on the rows and its points labelled (the time's front only:
+-- it is the one the results table colours); combined, the rows of every
+-- variant, a series per technique and variant, without a front (fronts
+-- compare one scene).
+local function error_vs(ctx, measure, rows, name, combined)
   local points, by_series, order = {}, {}, {}
   for _, r in ipairs(rows) do
-    local x, lo, hi = time_spread(r.record, ctx.time)
+    local x, lo, hi = measure.x(r.record)
     local p = { x = x, lo = lo, hi = hi, y = ctx.err(r), row = r }
     if type(p.y) == "number" and type(p.x) == "number" and p.x > 0 then
       points[#points + 1] = p
@@ -238,7 +262,7 @@ local function error_vs_time(ctx, rows, name, combined)
     local front = pareto.front(points)
     local fpts, labels = {}, {}
     for _, p in ipairs(front) do
-      p.row.on_front = true
+      if measure.file == "time" then p.row.on_front = true end
       fpts[#fpts + 1] = { p.x, p.y }
       labels[#labels + 1] = { p.x, p.y, p.row.label }
     end
@@ -246,12 +270,12 @@ local function error_vs_time(ctx, rows, name, combined)
     series[#series + 1] = { title = "Pareto labels", points = labels, style = "labels" }
   end
   local noise = noise_line(ctx, rows)
-  return plot.draw(ctx.dir, "error-vs-time-" .. name, {
-    title = ctx.err_label .. " against " .. time_fields[ctx.time] .. (combined and ", every scene variant" or ""),
+  return plot.draw(ctx.dir, "error-vs-" .. measure.file .. "-" .. name, {
+    title = ctx.err_label .. " against " .. measure.label .. (combined and ", every scene variant" or ""),
     rows = rows, noise = ctx.noise,
-    subtitle = (noise and "dashed: reference " .. ctx.noise.label .. "; " or "") .. spread_note ..
+    subtitle = (noise and "dashed: reference " .. ctx.noise.label .. "; " or "") .. measure.note ..
                (combined and "" or "\nPareto front circled, its points labelled with their configuration"),
-    xlabel = time_fields[ctx.time] .. " (ms, log scale)", ylabel = ctx.err_label, logx = true,
+    xlabel = measure.label .. " (" .. measure.unit .. ", log scale)", ylabel = ctx.err_label, logx = true,
     series = series, hline = noise,
   })
 end
@@ -333,8 +357,10 @@ end
 
 -- report.write(result [, opts]) for the result of experiment:run. opts:
 -- title, error ("all.rmse", "penumbra.rmse", "all.mae", ...), time ("frame",
--- "evaluate_median", "evaluate_min"). Returns the path of index.html (nil for
--- a shard: merge the shards, then run the script with --resume).
+-- "evaluate_median", "evaluate_min"), work (false: no plots of error against
+-- the work counters, records.work_counters, drawn beside error against time
+-- by default). Returns the path of index.html (nil for a shard: merge the
+-- shards, then run the script with --resume).
 function report.write(result, opts)
   opts = opts or {}
   if result.sharded then
@@ -351,7 +377,7 @@ function report.write(result, opts)
   local rows = ok_rows(result.rows)
   local axes = swept_names(rows)
   mark_swept(rows, axes)
-  local plots = { time = {}, axes = {} }
+  local plots = { time = {}, axes = {}, work = {} }
   local by_variant, variant_order = group_by(rows, function(r) return r.record.scene.hash end)
   local names_used = {}
   for _, h in ipairs(variant_order) do
@@ -359,9 +385,16 @@ function report.write(result, opts)
     local name = slug(v.scene .. (v.label ~= "" and "-" .. v.label or ""))
     if names_used[name] then name = name .. "-" .. h:sub(1, 8) end
     names_used[name] = true
-    plots.time[#plots.time + 1] = { variant = v, file = error_vs_time(ctx, by_variant[h], name), rows = by_variant[h] }
+    plots.time[#plots.time + 1] = { variant = v, file = error_vs(ctx, time_measure(ctx), by_variant[h], name),
+                                    rows = by_variant[h] }
+    if opts.work ~= false then
+      for _, counter in ipairs(records.work_counters) do
+        local file = error_vs(ctx, work_measure(counter), by_variant[h], name)
+        if file then plots.work[#plots.work + 1] = { variant = v, counter = counter[1], file = file } end
+      end
+    end
   end
-  if #variant_order > 1 then plots.combined = error_vs_time(ctx, rows, "all-variants", true) end
+  if #variant_order > 1 then plots.combined = error_vs(ctx, time_measure(ctx), rows, "all-variants", true) end
   local by_scene, scene_order = group_by(rows, function(r) return r.variant.file end)
   for _, f in ipairs(scene_order) do
     local scene_name = slug(by_scene[f][1].variant.scene)

@@ -90,17 +90,24 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* One timed evaluation of every row, in parallel. */
-static double evaluate_all(const Technique *t, const void *state, const TechContext *ctx, Image *out)
+/* One timed evaluation of every row, in parallel; its work into *work
+ * (counted by the shared readers in every thread, core/counters.h). */
+static double evaluate_all(const Technique *t, const void *state, const TechContext *ctx, Image *out,
+                           WorkCounters *work)
 {
     const ViewSamples *vs = ctx->vs;
+    WorkCounters w0, w1;
+    work_snapshot(&w0);
     double t0 = timer_now_s();
 #pragma omp parallel for schedule(dynamic, 1)
     for (int y = 0; y < vs->height; y++) {
         int begin = y * vs->width;
         t->evaluate(state, ctx, begin, begin + vs->width, out->data + (size_t)begin * (size_t)ctx->channels);
     }
-    return timer_now_s() - t0;
+    double dt = timer_now_s() - t0;
+    work_snapshot(&w1);
+    *work = work_diff(&w1, &w0);
+    return dt;
 }
 
 /* Convention for samples outside the evaluated class; broadcast a 1-channel
@@ -130,7 +137,7 @@ static bool run_evaluations(const RenderRequest *req, const RenderTiming *timing
     Progress prog; /* the progress line's "evaluate 3/10" (core/progress.h) */
     progress_begin(&prog, "evaluate", timing->warmup + req->repeat);
     for (out->warmup = 0; out->warmup < timing->warmup; out->warmup++) {
-        double t = evaluate_all(req->tech, state, ctx, &out->visibility);
+        double t = evaluate_all(req->tech, state, ctx, &out->visibility, &out->eval_work);
         progress_add(&prog, 1);
         if (timing->budget_s > 0 && t >= timing->budget_s) {
             times[n++] = total = t; /* long enough that caches cannot matter: it is the timed one */
@@ -138,7 +145,7 @@ static bool run_evaluations(const RenderRequest *req, const RenderTiming *timing
         }
     }
     while (n < req->repeat && (n == 0 || timing->budget_s <= 0 || total < timing->budget_s)) {
-        times[n] = evaluate_all(req->tech, state, ctx, &out->visibility);
+        times[n] = evaluate_all(req->tech, state, ctx, &out->visibility, &out->eval_work);
         total += times[n++];
         progress_add(&prog, 1);
     }
@@ -153,12 +160,17 @@ static bool run_evaluations(const RenderRequest *req, const RenderTiming *timing
 }
 
 /* The prepare's scope: its resources and their own build times summed by
- * category (the frame's, the G-buffer's, the set-up's). */
+ * category (the frame's, the G-buffer's, the set-up's); the frame ones'
+ * own work and bytes. */
 static void collect_tech_resources(const ResourceManager *rm, RenderResult *out)
 {
     for (int i = 0; i < rm_scope_count(rm); i++) {
         const ResourceEvent *ev = rm_scope_event(rm, i);
-        if (ev->category == RES_FRAME) out->tech_build_s += ev->own_s;
+        if (ev->category == RES_FRAME) {
+            out->tech_build_s += ev->own_s;
+            work_add(&out->frame_work, &ev->work);
+            out->frame_bytes += ev->bytes;
+        }
         if (ev->category == RES_GBUFFER) out->gbuffer_s += ev->own_s;
         if (ev->category == RES_SETUP) out->setup_s += ev->own_s;
         if (i < RENDER_MAX_TECH_RESOURCES) out->tech_resources[out->num_tech_resources++] = *ev;
@@ -203,9 +215,12 @@ bool lab_render_timed(Lab *lab, const RenderRequest *req, const RenderTiming *ti
     rm_scope_begin(lab->rm, req->repeat, timing->budget_s); /* frame resources built here: `repeat` times */
     Progress prog;
     progress_begin(&prog, "prepare", 0);
+    WorkCounters w0, w1;
+    work_snapshot(&w0);
     t0 = timer_now_s();
     bool prepared = req->tech->prepare(&ctx, &state, err);
     out->prepare_s = timer_now_s() - t0;
+    work_snapshot(&w1);
     progress_end(&prog);
     rm_scope_end(lab->rm);
     if (!prepared) {
@@ -215,8 +230,13 @@ bool lab_render_timed(Lab *lab, const RenderRequest *req, const RenderTiming *ti
     collect_tech_resources(lab->rm, out);
     double own_s = out->prepare_s - rm_scope_build_s(lab->rm);
     out->prepare_own_s = own_s > 0.0 ? own_s : 0.0;
+    WorkCounters prepare_work = work_diff(&w1, &w0), built = rm_scope_work(lab->rm),
+                 prepare_own_work = work_diff(&prepare_work, &built);
     bool ok = run_evaluations(req, timing, state, &ctx, out);
     out->frame_s = out->tech_build_s + out->prepare_own_s + out->eval_median_s;
+    work_add(&out->frame_work, &prepare_own_work);
+    work_add(&out->frame_work, &out->eval_work);
+    for (long s = 0; s < (long)vs->width * vs->height; s++) out->lit_candidates += cls[s] == SAMPLE_LIT_CANDIDATE;
     if (req->tech->release) req->tech->release(state);
     if (!ok) {
         render_result_free(out);

@@ -61,6 +61,15 @@ typedef struct RenderResult {
      * the set-up tables and the reference, and is the same whether this run
      * built the resources or reused them. */
     double frame_s;
+    /* Machine-independent work (core/counters.h), counted like the times:
+     * eval_work is one evaluation's (the last; each does the same work),
+     * frame_work the frame's = the frame resources' own builds' (also when
+     * reused) + the prepare's own + eval_work; frame_bytes the frame
+     * resources' bytes. lit_candidates: the samples evaluated, what the
+     * record's per-sample counts divide by. */
+    WorkCounters eval_work, frame_work;
+    size_t frame_bytes;
+    long lit_candidates;
 } RenderResult;
 
 bool lab_render(Lab *lab, const RenderRequest *req, RenderResult *out, Error *err);

@@ -193,6 +193,42 @@ static void write_timings(JsonWriter *w, const RunReport *r)
     json_object_end(w);
 }
 
+/* The counters' fields, into an open object. */
+static void write_counters(JsonWriter *w, const WorkCounters *c)
+{
+    json_int(w, "texel_fetches", (long long)c->texel_fetches);
+    json_int(w, "texel_bytes", (long long)c->texel_bytes);
+    json_int(w, "ray_calls", (long long)c->ray_calls);
+    json_int(w, "rays", (long long)c->rays);
+    json_int(w, "triangles", (long long)c->triangles);
+    json_int(w, "fragments", (long long)c->fragments);
+}
+
+/* Machine-independent work (core/counters.h): one evaluation's, the
+ * frame's (as timings_s.frame: its resources' own builds, the prepare's
+ * own, one evaluation) with the frame resources' bytes, and the
+ * evaluation's per lit candidate (null without any). texel_bytes are the
+ * bytes the reads load at the element size stored here (float32 depth: 4). */
+static void write_work(JsonWriter *w, const RenderResult *r)
+{
+    json_object_begin(w, "work");
+    json_int(w, "lit_candidates", r->lit_candidates);
+    json_object_begin(w, "evaluate");
+    write_counters(w, &r->eval_work);
+    json_object_end(w);
+    json_object_begin(w, "frame");
+    write_counters(w, &r->frame_work);
+    json_int(w, "bytes_built", (long long)r->frame_bytes);
+    json_object_end(w);
+    double n = r->lit_candidates > 0 ? (double)r->lit_candidates : NAN;
+    json_object_begin(w, "per_sample");
+    json_number(w, "texel_fetches", (double)r->eval_work.texel_fetches / n);
+    json_number(w, "texel_bytes", (double)r->eval_work.texel_bytes / n);
+    json_number(w, "rays", (double)r->eval_work.rays / n);
+    json_object_end(w);
+    json_object_end(w);
+}
+
 static void write_event(JsonWriter *w, const ResourceEvent *ev)
 {
     char hex[17];
@@ -208,6 +244,9 @@ static void write_event(JsonWriter *w, const ResourceEvent *ev)
     json_int(w, "builds", ev->builds);
     json_number(w, "cold_own_build_s", ev->cold_own_s);
     json_int(w, "bytes", (long long)ev->bytes);
+    json_object_begin(w, "work"); /* of its first build, net of the builds nested in it */
+    write_counters(w, &ev->work);
+    json_object_end(w);
     json_object_end(w);
 }
 
@@ -252,6 +291,7 @@ void report_write_record_fp(const RunReport *r, FILE *fp)
     if (r->metrics) write_metrics(&w, r);
     if (r->render && r->render->aux.data) write_aux(&w, r);
     write_timings(&w, r);
+    if (r->render) write_work(&w, r->render);
     write_resources(&w, r);
     write_machine(&w, r->threads);
     json_object_end(&w);

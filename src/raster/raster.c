@@ -16,6 +16,7 @@
 #include <string.h>
 #include "raster/clip.h"
 #include "core/array.h"
+#include "core/counters.h"
 
 #define SUB (1 << RASTER_SUBPIXEL_BITS) /* sub-texel steps per texel */
 #define HALF (SUB / 2)                  /* texel centre offset */
@@ -829,6 +830,7 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
     }
     free(cv);
     if (stats) *stats = st;
+    work_raster((uint64_t)st.triangles_in, (uint64_t)st.texels_written); /* counters.h */
     if (!ok) return error_set(err, "raster: out of memory (%ld triangles into %dx%d)", total, db->width, db->height);
     if (overflow)
         return error_set(err, "raster: %ld counter updates refused: the count would leave int32 [%d, %d]", overflow,

@@ -52,7 +52,7 @@ static void cast_face(ShadowMap *m, int face, RTCScene rtc, const RtScene *rs, c
             rh.ray.tfar = (float)fmax(reach, 0.0);
             rh.ray.mask = 0xFFFFFFFFu;
             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(rtc, &ctx, &rh);
+            rt_intersect1(rtc, &ctx, &rh);
             size_t k = base + (size_t)j * (size_t)m->res + (size_t)i;
             if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
                 m->depth[k] = INFINITY;

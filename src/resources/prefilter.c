@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/counters.h"
 #include "core/hash.h"
 #include "core/nanmath.h"
 
@@ -36,6 +37,12 @@ static inline void pf_put(PfStore *s, size_t i, double v)
 static inline double pf_round(const PfStore *s, double v) { return s->d ? v : (double)(float)v; }
 
 static size_t elem_bytes(bool f64) { return f64 ? sizeof(double) : sizeof(float); }
+
+/* Bytes of one entry (all channels) of a prefiltered map, for the counters. */
+static uint64_t entry_bytes(const Prefiltered *pf, int channels)
+{
+    return (uint64_t)channels * elem_bytes(pf->data.d != NULL);
+}
 
 static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
 
@@ -512,6 +519,8 @@ static void fetch_box(const Prefiltered *pf, int face, const PfFootprint *fp, do
             int I = clampi(fp->i0 + a + half + pf->pad, 0, S - 1), J = clampi(fp->j0 + b + half + pf->pad, 0, S - 1);
             at[b][a] = (((size_t)face * S + J) * S + I) * C;
         }
+    int taps = (w[0][0] > 0.0) + (w[0][1] > 0.0) + (w[1][0] > 0.0) + (w[1][1] > 0.0);
+    work_texels((uint64_t)taps, entry_bytes(pf, C)); /* the entries read below, all channels each */
     for (int c = 0; c < C; c++) {
         double v[2][2];
         for (int b = 0; b < 2; b++)
@@ -534,6 +543,8 @@ static bool fetch_sat(const Prefiltered *pf, int face, const PfFootprint *fp, do
     size_t face0 = (size_t)face * E * E;
     double area = (double)K * K;
     bool reliable = true;
+    int windows = (w[0][0] > 0.0) + (w[0][1] > 0.0) + (w[1][0] > 0.0) + (w[1][1] > 0.0);
+    work_texels(4 * (uint64_t)windows, entry_bytes(pf, C)); /* four corners per window read below */
     for (int c = 0; c < C; c++) {
         double v[2][2], off = pf->offset[face * C + c];
 #define S_(x, y) pf_get(&pf->data, (face0 + (size_t)Y[y] * E + X[x]) * C + c)
@@ -598,6 +609,7 @@ bool pf_fetch_box(const Prefiltered *pf, int face, double s, double t, double hx
     sat_corner(pf, face0, x1, y0, -1.0, at + 8, w + 8);
     sat_corner(pf, face0, x0, y0, 1.0, at + 12, w + 12);
     double inv_area = 1.0 / (4.0 * hx * hy);
+    work_texels(16, entry_bytes(pf, channels));
     for (int c = 0; c < channels; c++) {
         double sum = 0.0;
         for (int k = 0; k < 16; k++) sum += w[k] * pf_get(&pf->data, at[k] + c);
@@ -717,6 +729,7 @@ void minmax_query(const MinMaxPyramid *p, int face, int i0, int j0, int i1, int 
     j1 = clampi(j1, 0, p->res - 1);
     int l = minmax_query_level(p, i0, j0, i1, j1);
     float lo = INFINITY, hi = -INFINITY;
+    work_texels((uint64_t)((j1 >> l) - (j0 >> l) + 1) * (uint64_t)((i1 >> l) - (i0 >> l) + 1), 2 * sizeof(float));
     for (int j = j0 >> l; j <= j1 >> l; j++)
         for (int i = i0 >> l; i <= i1 >> l; i++) {
             const float *q = node(p, l, face, i, j);
@@ -732,15 +745,18 @@ float minmax_node_min(const MinMaxPyramid *p, int face, int level, int *i, int *
     *i = clampi(*i, 0, p->size[level] - 1);
     *j = clampi(*j, 0, p->size[level] - 1);
     float lo = node(p, level, face, *i, *j)[0];
+    uint64_t reads = 1;
     for (int l = level; l > 0; l--) { /* the child holding the minimum, the first in scan order on ties */
         int below = p->size[l - 1], ci = 2 * *i, cj = 2 * *j;
         for (int k = 0; k < 4; k++) {
             int a = clampi(2 * *i + (k & 1), 0, below - 1), b = clampi(2 * *j + (k >> 1), 0, below - 1);
+            reads++;
             if (node(p, l - 1, face, a, b)[0] == lo) { ci = a; cj = b; break; }
         }
         *i = ci;
         *j = cj;
     }
+    work_texels(reads, 2 * sizeof(float)); /* a node: its min and max */
     return lo;
 }
 
@@ -855,6 +871,7 @@ void minmax_buffer_query(const MinMaxBuffer *b, int face, int i0, int j0, int i1
     int step = 1 << b->level, xs[PREFILTER_MAX_K + 2], ys[PREFILTER_MAX_K + 2];
     int nx = block_starts(i0, i1, step, xs, PREFILTER_MAX_K + 2), ny = block_starts(j0, j1, step, ys, PREFILTER_MAX_K + 2);
     float lo = INFINITY, hi = -INFINITY;
+    work_texels((uint64_t)nx * (uint64_t)ny, 2 * sizeof(float));
     for (int y = 0; y < ny; y++)
         for (int x = 0; x < nx; x++) {
             const float *q = b->minmax + 2 * (((size_t)face * b->res + ys[y]) * b->res + xs[x]);

@@ -27,11 +27,17 @@ typedef struct Entry {
     IntList deps;    /* entries acquired while it was built */
     int builds;      /* build_s and own_s are medians of this many builds */
     double cold_own_s;
+    WorkCounters work; /* of its first build, less the builds nested inside it */
 } Entry;
 
 /* A build in progress: what it acquires, how long its nested builds took and
  * the category they are acquired for. */
-typedef struct BuildFrame { IntList deps; double nested_s; ResourceCategory context; } BuildFrame;
+typedef struct BuildFrame {
+    IntList deps;
+    double nested_s;
+    WorkCounters nested_work;
+    ResourceCategory context;
+} BuildFrame;
 
 /* A growable list of events, deduplicated by (kind, key). */
 typedef struct EventList { ResourceEvent *ev; int n, cap; } EventList;
@@ -46,6 +52,7 @@ struct ResourceManager {
     int builds;      /* of each frame resource built in the scope (rm_scope_begin) */
     double budget_s; /* > 0: and no more once they took this long */
     double scope_build_s;
+    WorkCounters scope_work; /* of the builds inside the scope, as scope_build_s */
     EventList scope;
     ResourceBuiltFn on_build; /* rm_on_build */
     void *on_build_user;
@@ -141,6 +148,7 @@ static bool event_add(EventList *l, const Entry *e, const char *desc, bool built
     ev->category = category;
     ev->builds = e->builds;
     ev->cold_own_s = e->cold_own_s;
+    ev->work = e->work;
     return true;
 }
 
@@ -164,11 +172,13 @@ static int find(const ResourceManager *rm, const ResourceKind *kind, uint64_t ke
     return -1;
 }
 
-/* One build in a new frame, timed: the resource (NULL + err on failure), its
- * wall time and its own time net of the builds nested inside it. The frame
- * stays readable (its deps) until the next build at this depth. */
+/* One build in a new frame, timed and counted: the resource (NULL + err on
+ * failure), its wall time and its own time and work net of the builds nested
+ * inside it. The frame stays readable (its deps) until the next build at
+ * this depth. */
 static void *timed_build(ResourceManager *rm, const ResourceKind *kind, ResourceCategory category,
-                         ResourceBuildFn build, const void *args, double *wall_s, double *own_s, Error *err)
+                         ResourceBuildFn build, const void *args, double *wall_s, double *own_s,
+                         WorkCounters *own_work, Error *err)
 {
     if (rm->depth == RM_MAX_DEPTH) {
         error_set(err, "resources nested more than %d deep (building %s)", RM_MAX_DEPTH, kind->name);
@@ -177,21 +187,27 @@ static void *timed_build(ResourceManager *rm, const ResourceKind *kind, Resource
     BuildFrame *f = &rm->frames[rm->depth++];
     f->deps.n = 0;
     f->nested_s = 0;
+    f->nested_work = (WorkCounters){0};
     f->context = category;
     Progress prog; /* "... > shadow_map, 2.1 s" on a terminal (core/progress.h) */
     progress_begin(&prog, kind->name, 0);
+    WorkCounters w0, w1;
+    work_snapshot(&w0);
     double t0 = timer_now_s();
     void *res = build(args, err);
     *wall_s = timer_now_s() - t0;
+    work_snapshot(&w1);
     progress_end(&prog);
     *own_s = *wall_s > f->nested_s ? *wall_s - f->nested_s : 0.0;
+    WorkCounters wall_work = work_diff(&w1, &w0);
+    *own_work = work_diff(&wall_work, &f->nested_work);
     rm->depth--;
     return res;
 }
 
 /* Store a built resource; its index, or -1 with err set (and res destroyed). */
 static int store_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc, void *res,
-                       double wall_s, double own_s, Error *err)
+                       double wall_s, double own_s, const WorkCounters *own_work, Error *err)
 {
     Entry *entries = array_room(rm->entries, rm->count, &rm->cap, sizeof *entries, 16);
     if (!entries) {
@@ -201,7 +217,7 @@ static int store_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t k
     }
     rm->entries = entries;
     Entry *e = &rm->entries[rm->count];
-    *e = (Entry){kind, key, res, wall_s, own_s, kind->bytes(res), "", {NULL, 0, 0}, 1, own_s};
+    *e = (Entry){kind, key, res, wall_s, own_s, kind->bytes(res), "", {NULL, 0, 0}, 1, own_s, *own_work};
     snprintf(e->desc, sizeof e->desc, "%s", desc);
     const IntList *deps = &rm->frames[rm->depth].deps; /* the build's frame, just popped */
     for (int i = 0; i < deps->n; i++) int_list_add_unique(&e->deps, deps->v[i]);
@@ -221,7 +237,8 @@ static bool rebuild_for_median(ResourceManager *rm, int i, ResourceBuildFn build
     double total_s = wall_s[0];
     int n = 1;
     for (; n < rm->builds && (rm->budget_s <= 0 || total_s < rm->budget_s); n++) {
-        void *res = timed_build(rm, kind, RES_FRAME, build, args, &wall_s[n], &own_s[n], err);
+        WorkCounters work; /* the first build's again: the entry keeps that */
+        void *res = timed_build(rm, kind, RES_FRAME, build, args, &wall_s[n], &own_s[n], &work, err);
         if (!res) {
             free(wall_s);
             return false;
@@ -238,20 +255,29 @@ static bool rebuild_for_median(ResourceManager *rm, int i, ResourceBuildFn build
 }
 
 /* Build, time and store a new entry (a frame one inside a scope rm->builds
- * times); its index, or -1 with err set. Its whole time, rebuilds included,
- * is nested time of the build around it and build time of the scope. */
+ * times); its index, or -1 with err set. Its whole time and work, rebuilds
+ * included, are nested in the build around it and built in the scope. */
 static int build_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc,
                        ResourceBuildFn build, const void *args, Error *err)
 {
     ResourceCategory category = category_in(current_context(rm), kind);
+    WorkCounters w0, w1, own_work;
+    work_snapshot(&w0);
     double t0 = timer_now_s(), wall_s, own_s;
-    void *res = timed_build(rm, kind, category, build, args, &wall_s, &own_s, err);
-    int i = res ? store_entry(rm, kind, key, desc, res, wall_s, own_s, err) : -1;
+    void *res = timed_build(rm, kind, category, build, args, &wall_s, &own_s, &own_work, err);
+    int i = res ? store_entry(rm, kind, key, desc, res, wall_s, own_s, &own_work, err) : -1;
     bool repeat = i >= 0 && rm->scoping && category == RES_FRAME && rm->builds > 1;
     if (repeat && !rebuild_for_median(rm, i, build, args, err)) i = -1; /* the entry stays: it is sound */
     double dt = timer_now_s() - t0;
-    if (rm->depth > 0) rm->frames[rm->depth - 1].nested_s += dt;
-    else if (rm->scoping) rm->scope_build_s += dt;
+    work_snapshot(&w1);
+    WorkCounters dw = work_diff(&w1, &w0);
+    if (rm->depth > 0) {
+        rm->frames[rm->depth - 1].nested_s += dt;
+        work_add(&rm->frames[rm->depth - 1].nested_work, &dw);
+    } else if (rm->scoping) {
+        rm->scope_build_s += dt;
+        work_add(&rm->scope_work, &dw);
+    }
     return i;
 }
 
@@ -295,12 +321,14 @@ void rm_scope_begin(ResourceManager *rm, int builds, double budget_s)
     rm->builds = builds > 1 ? builds : 1;
     rm->budget_s = budget_s;
     rm->scope_build_s = 0;
+    rm->scope_work = (WorkCounters){0};
     rm->scope.n = 0;
 }
 void rm_scope_end(ResourceManager *rm) { rm->scoping = false; }
 int rm_scope_count(const ResourceManager *rm) { return rm->scope.n; }
 const ResourceEvent *rm_scope_event(const ResourceManager *rm, int i) { return &rm->scope.ev[i]; }
 double rm_scope_build_s(const ResourceManager *rm) { return rm->scope_build_s; }
+WorkCounters rm_scope_work(const ResourceManager *rm) { return rm->scope_work; }
 
 size_t rm_bytes(const ResourceManager *rm)
 {

@@ -10,6 +10,7 @@
 #define SL_RESOURCES_H
 #include <stddef.h>
 #include <stdint.h>
+#include "core/counters.h"
 #include "core/error.h"
 
 /* What a renderer would pay for a resource each frame (architecture.md,
@@ -48,6 +49,7 @@ typedef struct ResourceEvent {
     ResourceCategory category; /* the kind's, or the one it was acquired for (see above) */
     int builds;       /* build_s and own_s are the medians of this many builds (rm_scope_begin) */
     double cold_own_s; /* own_s of the first of them */
+    WorkCounters work; /* counters.h: of its first build, less the builds nested inside it */
 } ResourceEvent;
 
 typedef struct ResourceManager ResourceManager;
@@ -100,6 +102,8 @@ const ResourceEvent *rm_scope_event(const ResourceManager *rm, int i);
 /* Wall time of the builds made inside the scope, every repeat and category
  * (what the stage's own set-up is net of). */
 double rm_scope_build_s(const ResourceManager *rm);
+/* The work (counters.h) of those builds, every repeat and category. */
+WorkCounters rm_scope_work(const ResourceManager *rm);
 
 /* Totals over everything the manager holds. */
 size_t rm_bytes(const ResourceManager *rm);

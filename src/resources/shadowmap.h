@@ -8,6 +8,7 @@
  * both acquire both and share the first with everyone else. */
 #ifndef SL_SHADOWMAP_H
 #define SL_SHADOWMAP_H
+#include "core/counters.h"
 #include "resources/lightview.h"
 #include "resources/resources.h"
 
@@ -53,12 +54,24 @@ const ShadowMap *res_shadow_map(ResourceManager *rm, const Scene *scene, int lig
 /* Bytes a map of this spec would take (faces from the light and projection). */
 size_t shadowmap_bytes_for(const Light *light, const ShadowMapSpec *spec);
 
-/* Stored depth of texel (i, j) of a face, clamped to the edge. */
+/* Stored depth of texel (i, j) of a face, clamped to the edge: one texel
+ * fetch of 4 bytes (counters.h). */
 static inline float shadowmap_texel(const ShadowMap *m, int face, int i, int j)
 {
+    work_texels(1, sizeof *m->depth);
     i = i < 0 ? 0 : i >= m->res ? m->res - 1 : i;
     j = j < 0 ? 0 : j >= m->res ? m->res - 1 : j;
     return m->depth[((size_t)face * (size_t)m->res + (size_t)j) * (size_t)m->res + (size_t)i];
+}
+
+/* Row j of a face, clamped to the edge, for a caller that reads `taps`
+ * texels of it itself (a box filter's row loop): counted here as those taps,
+ * so a vectorised row loop carries no counter. */
+static inline const float *shadowmap_row(const ShadowMap *m, int face, int j, int taps)
+{
+    work_texels((uint64_t)taps, sizeof *m->depth);
+    j = j < 0 ? 0 : j >= m->res ? m->res - 1 : j;
+    return m->depth + ((size_t)face * (size_t)m->res + (size_t)j) * (size_t)m->res;
 }
 
 #endif

@@ -269,7 +269,7 @@ static int trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx,
     for (int first = 0; first < j->count; first += PACKET) {
         fill_batch(b, j->light, org, p, ng, stream, first, j->count, j->p);
         rays += (j->count - first < PACKET ? j->count - first : PACKET) - b->below_horizon;
-        rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
+        rt_occluded16(b->valid, j->rtc, ctx, &b->ray);
         int batch = sampling_batch_of(j->p->pattern, first, j->count);
         if (j->p->measure == MEASURE_IRRADIANCE)
             accumulate_irradiance(&a, b, batch, m, j->vs->n_shading_world[s],
@@ -280,7 +280,7 @@ static int trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx,
     bool sliver = rays == 0 && j->p->measure == MEASURE_VISIBILITY;
     if (sliver) {
         fill_highest(b, j->light, org, p, ng);
-        rtcOccluded16(b->valid, j->rtc, ctx, &b->ray);
+        rt_occluded16(b->valid, j->rtc, ctx, &b->ray);
         accumulate_visibility(&a, b, 0, m, nc);
         rays = 1;
     }

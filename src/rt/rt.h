@@ -6,6 +6,7 @@
 #define SL_RT_H
 #include <embree3/rtcore.h>
 #include <stddef.h>
+#include "core/counters.h"
 #include "scene/scene.h"
 
 typedef struct RtScene RtScene;
@@ -31,5 +32,29 @@ int rt_scene_object(const RtScene *rs, unsigned geom_id);
  * the surface it was found on: scaled to the scene's extent and to the
  * point's magnitude, since float error of a hit point grows with both. */
 float rt_ray_offset(float scene_extent, vec3 p_world);
+
+/* Embree's ray calls, counted (counters.h: one call, and the rays it
+ * traces). Every ray the lab traces goes through these. */
+static inline void rt_occluded1(RTCScene scene, struct RTCIntersectContext *ctx, struct RTCRay *ray)
+{
+    work_ray_call(1);
+    rtcOccluded1(scene, ctx, ray);
+}
+
+static inline void rt_intersect1(RTCScene scene, struct RTCIntersectContext *ctx, struct RTCRayHit *rayhit)
+{
+    work_ray_call(1);
+    rtcIntersect1(scene, ctx, rayhit);
+}
+
+/* A packet of 16: its rays are the lanes whose valid[k] is non-zero (-1). */
+static inline void rt_occluded16(const int *valid, RTCScene scene, struct RTCIntersectContext *ctx,
+                                 struct RTCRay16 *ray)
+{
+    int lanes = 0;
+    for (int k = 0; k < 16; k++) lanes += valid[k] != 0;
+    work_ray_call((uint64_t)lanes);
+    rtcOccluded16(valid, scene, ctx, ray);
+}
 
 #endif

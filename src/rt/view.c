@@ -106,7 +106,7 @@ bool view_samples_trace(const RtScene *rs, const Scene *scene, ViewSamples *vs, 
             rh.ray.tfar = cam->far_dist / cos_axis;
             rh.ray.mask = 0xFFFFFFFFu;
             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(rtc, &ctx, &rh);
+            rt_intersect1(rtc, &ctx, &rh);
             if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
                 vs->object[s] = vs->prim[s] = -1;
                 vs->p_world[s] = vs->n_geom_world[s] = vs->n_shading_world[s] = v3(0, 0, 0);

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "core/hash.h"
+#include "core/counters.h"
 #include "resources/silhouette.h"
 #include "resources/standard.h"
 
@@ -441,7 +442,7 @@ bool exact_occluded(const ExactCasters *c, vec3 org, const LightSample *ls)
     struct RTCRay ray = {.org_x = org.x, .org_y = org.y, .org_z = org.z, .tnear = 0.0f,
                          .dir_x = ls->dir_world.x, .dir_y = ls->dir_world.y, .dir_z = ls->dir_world.z,
                          .tfar = isinf(ls->dist) ? INFINITY : ls->dist * (1.0f - 1e-5f), .mask = 0xFFFFFFFFu};
-    rtcOccluded1(c->rtc, &ictx, &ray);
+    rt_occluded1(c->rtc, &ictx, &ray);
     return ray.tfar == -INFINITY;
 }
 
@@ -455,6 +456,7 @@ float exact_sliver_visibility(const ExactCasters *c, const TechContext *ctx, int
  * org: the sign of n . (org - corner 0). */
 static int relative_corners(const Frame *f, const vec3 *t, dvec3 q[3], double h[3])
 {
+    work_raster(1, 0); /* a triangle set up against the light frame (core/counters.h) */
     for (int k = 0; k < 3; k++) {
         q[k] = d3_sub(d3_from(t[k]), f->org);
         h[k] = d3_dot(q[k], f->c);

@@ -48,7 +48,7 @@ static void hard_evaluate(const void *state, const TechContext *ctx, int begin, 
             .org_x = org.x, .org_y = org.y, .org_z = org.z, .tnear = 0.0f,
             .dir_x = ls.dir_world.x, .dir_y = ls.dir_world.y, .dir_z = ls.dir_world.z,
             .tfar = isinf(ls.dist) ? INFINITY : ls.dist * (1.0f - 1e-5f), .mask = 0xFFFFFFFFu};
-        rtcOccluded1(hs->rtc, &ictx, &ray);
+        rt_occluded1(hs->rtc, &ictx, &ray);
         float vis = ray.tfar == -INFINITY ? 0.0f : 1.0f;
         for (int c = 0; c < ctx->channels; c++) o[c] = vis;
     }

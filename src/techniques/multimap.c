@@ -25,6 +25,7 @@
  * counting every sample (lit everywhere). test_multimap measures both. */
 #include <stdlib.h>
 #include <string.h>
+#include "core/counters.h"
 #include "rt/rt.h"
 #include "techniques/multimap.h"
 
@@ -344,6 +345,7 @@ static float la_visibility(const LaState *st, vec3 p, vec3 n, float *aux)
     aux[0] = l->used[t];
     aux[1] = (float)l->overflow[t];
     if (l->unknown[t]) return NAN;
+    work_texels(l->used[t], sizeof *l->depth + sizeof *l->count); /* the texel's layers read (core/counters.h) */
     int e = ldi_match(l, t, z, st->epsilon);
     return e < 0 ? 0.0f : (float)l->count[t * l->cap + e] / (float)st->n;
 }

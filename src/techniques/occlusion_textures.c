@@ -40,6 +40,7 @@
  * windows after it, as it would through a float SAT). The slices' depth
  * range is the finite depths'. */
 #include <stdlib.h>
+#include "core/counters.h"
 #include "techniques/backproject.h"
 
 enum { P_SLICES = SMAP_NUM_PARAMS, P_FILTER };
@@ -265,6 +266,7 @@ static double sat_mean(const OtState *st, int face, int t, int i0, int j0, int i
 {
     int n = st->stride;
     const uint32_t *s = sat_of(st, face, t);
+    work_texels(4, sizeof *s); /* the SAT's four corners (core/counters.h) */
     double count = (double)s[(size_t)(j1 + 1) * n + i1 + 1] - s[(size_t)j0 * n + i1 + 1] - s[(size_t)(j1 + 1) * n + i0] +
                    s[(size_t)j0 * n + i0];
     return count / ((double)(i1 - i0 + 1) * (j1 - j0 + 1));
@@ -287,6 +289,7 @@ static double nbuffer_mean(const OtState *st, int face, int k, int i0, int j0, i
     int kx = i1 - i0 + 1, ky = j1 - j0 + 1, l = floor_log2(kx < ky ? kx : ky), b = 1 << l;
     int nx = (kx + b - 1) / b, ny = (ky + b - 1) / b, res = st->level_res[l];
     const float *lv = level_of(st, face, k, l);
+    work_texels(nx * ny, sizeof *lv); /* one read per block */
     double sum = 0.0;
     for (int y = 0; y < ny; y++)
         for (int x = 0; x < nx; x++)
@@ -309,6 +312,7 @@ static double mipmap_mean(const OtState *st, int face, int k, int i0, int j0, in
     int xa = x0 < 0 ? 0 : clamp_index(x0, n), xb = clamp_index(x0 + 1 < 0 ? 0 : x0 + 1, n);
     int ya = y0 < 0 ? 0 : clamp_index(y0, n), yb = clamp_index(y0 + 1 < 0 ? 0 : y0 + 1, n);
     const float *lv = level_of(st, face, k, l);
+    work_texels(4, sizeof *lv); /* the bilinear footprint */
     double top = (1 - fx) * lv[(size_t)ya * n + xa] + fx * lv[(size_t)ya * n + xb];
     double bottom = (1 - fx) * lv[(size_t)yb * n + xa] + fx * lv[(size_t)yb * n + xb];
     return (1 - fy) * top + fy * bottom;

@@ -74,6 +74,7 @@
  * or cube: softmap_frames refuses others by name). */
 #include <math.h>
 #include <stdlib.h>
+#include "core/counters.h"
 #include "raster/segment.h"
 #include "resources/silhouette.h"
 #include "rt/outer.h"
@@ -335,6 +336,7 @@ static float outer_lit(const OuterState *st, const SmapReceiver *r, int i, int j
     i = i < 0 ? 0 : i >= m->res ? m->res - 1 : i;
     j = j < 0 ? 0 : j >= m->res ? m->res - 1 : j;
     size_t k = texel_index(m, r->mc.face, i, j);
+    work_texels(buffer_floats(st->kind), sizeof *st->value); /* the buffer's texel (core/counters.h) */
     if (st->kind == OUTER_PENUMBRA_MAP) return 1.0f - st->value[k]; /* Wyman & Hansen's I is the shadow's */
     double z_s = st->depth[k], z_r = r->mc.depth_linear;
     if (!(z_r > z_s)) return 1.0f; /* in front of the smoothie, or none here */

@@ -108,8 +108,8 @@ static bool pcf_prepare(const TechContext *ctx, void **state, Error *err)
  * texel (or reference) is neither, and makes the row NaN. */
 static float box_row_lit(const ShadowMap *m, int face, int i0, int j, int K, float ref)
 {
-    int res = m->res, jc = j < 0 ? 0 : j >= res ? res - 1 : j, lit = 0, shadowed = 0;
-    const float *row = m->depth + ((size_t)face * (size_t)res + (size_t)jc) * (size_t)res;
+    int res = m->res, lit = 0, shadowed = 0;
+    const float *row = shadowmap_row(m, face, j, K); /* counts the K taps (core/counters.h) */
     if (i0 >= 0 && i0 + K <= res) {
         for (int i = i0; i < i0 + K; i++) {
             lit += ref <= row[i];

@@ -107,7 +107,7 @@ static bool inner_blocked(RTCScene casters, vec3 org, const LightSample *ls)
         .org_x = org.x, .org_y = org.y, .org_z = org.z, .tnear = 0.0f,
         .dir_x = ls->dir_world.x, .dir_y = ls->dir_world.y, .dir_z = ls->dir_world.z,
         .tfar = ls->dist * (1.0f - 1e-5f), .mask = 0xFFFFFFFFu};
-    rtcOccluded1(casters, &ictx, &ray);
+    rt_occluded1(casters, &ictx, &ray);
     return ray.tfar == -INFINITY;
 }
 
