@@ -345,7 +345,7 @@ figure course_ch7_coarse_worse_than_pcss "$R/course-ch7-backprojection-vs-pcss/r
     item~"sphere-on-plane: backprojection T = 2" --hold
 figure course_fig1_8_hidden_layer "$R/course-fig1.8-layers/reproduction.csv" measured 3 8 \
     item~"one-layer: layers needed" --hold
-figure course_fig1_8_few_layers_cost "$R/course-fig1.8-layers/reproduction.csv" measured 1 10 item~"cap 2 / cap 64" --hold
+figure course_fig1_8_few_layers_cost "$R/course-fig1.8-layers/reproduction.csv" measured 1 10 item~"cap 2 / cap 16" --hold
 figure fig3_7_lispsm_product "$R/fig3-7-aliasing-vs-z/reproduction.csv" measured 95 103 \
     item~LiSPSM quantity~"max e_x x" --hold
 figure fig3_13_no_warping_behind "$R/fig3-13-storage-factor/reproduction.csv" measured 0.9 1.1 item~"behind: W" --hold
