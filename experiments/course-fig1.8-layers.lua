@@ -4,8 +4,8 @@
 -- Measured with layered_attenuation (Agrawala et al. 2000, course §5.2.4;
 -- src/techniques/multimap.c) at a layer cap of 16 (texel overflows are
 -- reported, and a scene with any is not counted): the N light samples' maps
--- warped into a layered depth
--- image from the centre, its aux `layers` the number of distinct surfaces
+-- warped into a layered depth image from the centre, its aux `layers` the
+-- number of distinct surfaces
 -- (within epsilon along the centre's depth axis) that some light sample sees
 -- in the texel of each receiver (the receiver's own and any behind it
 -- included). A single map from the centre holds one of them; an LDI capped
@@ -52,7 +52,16 @@ local function scene_files()
     end
     table.sort(names)
   else
-    for f in args.extra.scenes:gmatch("[^,]+") do names[#names + 1] = (f:gsub("^scenes/", "")) end
+    for f in args.extra.scenes:gmatch("[^,]+") do
+      local name = f:gsub("^scenes/", "")
+      local fh = io.open(sl.root .. "/scenes/" .. name, "r")
+      if not fh then
+        io.stderr:write("course-fig1.8-layers: --scenes: no scene file scenes/" .. name .. "\n")
+        os.exit(2)
+      end
+      fh:close()
+      names[#names + 1] = name
+    end
   end
   return names
 end
