@@ -278,6 +278,10 @@ run_repro() { # run_repro EXPERIMENT ARGS...: its output in $R/EXPERIMENT.log, i
     run_repro soft-failures --set camera.width=40 --set camera.height=30 --samples 16 --quiet --threads 1
     run_repro course-fig5.10-5.11-multiscale --set camera.width=80 --set camera.height=60 --samples 16 --repeat 1 \
         --warmup 0 --no-images --quiet --threads 1 # ~20 s on a loaded machine
+    run_repro course-fig5.5-5.8-occluders --set camera.width=48 --set camera.height=36 --samples 16 --repeat 1 \
+        --warmup 0 --no-images --quiet --threads 1 # ~2 s
+    run_repro course-fig1.8-layers --scenes one-layer.lua,overlap.lua,sphere-on-plane.lua --map-size 256 \
+        --set camera.width=48 --set camera.height=36 --samples 16 --threads 1 # ~2 s
 ) &
 lane=$!
 run_repro seed000-fig3 $TINYQ
@@ -292,12 +296,14 @@ run_repro course-fig5.14-outer-penumbra --set camera.width=80 --set camera.heigh
 run_repro fig3-10-12-partitions $TINYQ
 run_repro course-fig2.4-2.10-shadow-volumes --quick 1 --rounds 1 --set camera.width=64 --set camera.height=48 --threads 1
 run_repro exact-soft-vs-rays --quick 1 --set camera.width=48 --set camera.height=36 --threads 1
+run_repro course-ch7-backprojection-vs-pcss --set camera.width=48 --set camera.height=36 --samples 16 --repeat 1 \
+    --warmup 0 --no-images --quiet --threads 1 # ~5 s with the bunny
 wait "$lane"
 for e in seed000-fig3 seed001-adaptive-area seed002-single-sample seed003-shadow-width seed003-table1 \
          course-fig2.2-bias course-fig2.3-midpoint course-fig4.3-pcf-umbra course-fig4.5-vsm-bleeding \
          course-fig4.7-csm-terms course-fig5.10-5.11-multiscale course-fig5.14-outer-penumbra fig3-7-aliasing-vs-z \
          fig3-10-12-partitions fig3-13-storage-factor course-fig2.4-2.10-shadow-volumes exact-soft-vs-rays \
-         soft-failures; do
+         soft-failures course-fig5.5-5.8-occluders course-ch7-backprojection-vs-pcss course-fig1.8-layers; do
     expect "${e}_reproduces" 0 "paper against measured" "reproduction:" -- \
         sh -c 'cat "$1.log"; exit "$(cat "$1.rc" 2>/dev/null || echo 1)"' sh "$R/$e"
 done
@@ -331,6 +337,15 @@ figure course_fig5_14_umbra_overestimated "$R/course-fig5.14-outer-penumbra/repr
     quantity~"umbra share" --hold
 figure course_fig5_10_mssm_classifies_better "$R/course-fig5.10-5.11-multiscale/reproduction.csv" measured 0.3 1 \
     item~"mssm / hsm" --hold
+figure course_fig5_5_gaps_leak "$R/course-fig5.5-5.8-occluders/reproduction.csv" measured 1 100 \
+    item~"micropatch/none /" --hold
+figure course_fig5_8_microquad_misses_twigs "$R/course-fig5.5-5.8-occluders/reproduction.csv" measured 1 1000 \
+    item~"twig: microquad" --hold
+figure course_ch7_coarse_worse_than_pcss "$R/course-ch7-backprojection-vs-pcss/reproduction.csv" measured 1 100 \
+    item~"sphere-on-plane: backprojection T = 2" --hold
+figure course_fig1_8_hidden_layer "$R/course-fig1.8-layers/reproduction.csv" measured 3 8 \
+    item~"one-layer: layers needed" --hold
+figure course_fig1_8_few_layers_cost "$R/course-fig1.8-layers/reproduction.csv" measured 1 10 item~"cap 2 / cap 16" --hold
 figure fig3_7_lispsm_product "$R/fig3-7-aliasing-vs-z/reproduction.csv" measured 95 103 \
     item~LiSPSM quantity~"max e_x x" --hold
 figure fig3_13_no_warping_behind "$R/fig3-13-storage-factor/reproduction.csv" measured 0.9 1.1 item~"behind: W" --hold
