@@ -93,7 +93,8 @@ enum { CLASS_LIT, CLASS_UMBRA, CLASS_BACKPROJECTED }; /* aux `class` */
     {"accumulate", PARAM_ENUM, ACC_BITMASK, 0, 1, "",                                                              \
      "bitmask (Schwarz & Stamminger 2007: one bit per light sample, the union of the occluders' masks, V = 1 - "   \
      "popcount / N) or area (course §5.2.3.1: each occluder's share of the light summed, over-occluding where "    \
-     "occluders overlap; shares measured with the same samples)",                                                  \
+     "occluders overlap; shares measured with the same samples; occluder=contour: the loops' exact share by "    \
+     "signed radial areas, bitmask their enclosed samples)",                                                       \
      accumulate_names},                                                                                            \
     {"tiles", PARAM_INT, 8, 1, 16, "tiles",                                                                        \
      "light samples: a tiles x tiles tiling of the 2 x 2 rotated grid (RGSS), N = 4 tiles^2 (8: the course's "     \
