@@ -17,6 +17,9 @@
  *       microquad   the quad of the unprojected centres of 2 x 2 lexels,
  *                   used only when all four pass (§5.2.3.3);
  *       microtri    the same quad, or the triangle of three of the four;
+ *       contour     (Guennebaud et al. 2007) the outline of the blocking
+ *                   lexels, one closed loop per connected region, from a
+ *                   16-case edge table (contour_visibility);
  *     and projected back from p onto the light's plane
  *     (backproject_light_scale, L = k (x - u));
  *  3. accumulated over the light's N samples (4 tiles^2 on the RGSS
@@ -24,7 +27,9 @@
  *     samples each polygon covers, V = 1 - popcount / N (§5.2.3.2, fusion
  *     exact up to the sample count); area = each polygon's covered share
  *     summed, V = 1 - min(1, sum) (§5.2.3.1's summed areas, measured by the
- *     same samples: over-occludes where polygons overlap).
+ *     same samples: over-occludes where polygons overlap); contour's loops
+ *     take the bitmask by the crossing parity of their edges and the area
+ *     exactly, by Green's theorem (radial_area.h).
  * Only casters seen from the light's centre exist (one layer; course
  * Fig. 1.8). The light is the scene's (sphere: its central cross-section).
  *
@@ -52,9 +57,10 @@
 #include <stdlib.h>
 #include "core/nanmath.h"
 #include "techniques/backproject.h"
+#include "techniques/radial_area.h"
 
-enum { OCC_MICROPATCH, OCC_MICROQUAD, OCC_MICROTRI };
-static const char *const occluder_names[] = {"micropatch", "microquad", "microtri", NULL};
+enum { OCC_MICROPATCH, OCC_MICROQUAD, OCC_MICROTRI, OCC_CONTOUR };
+static const char *const occluder_names[] = {"micropatch", "microquad", "microtri", "contour", NULL};
 enum { GAPS_NONE, GAPS_GUENNEBAUD, GAPS_DIAGONAL };
 static const char *const gaps_names[] = {"none", "guennebaud", "diagonal", NULL};
 enum { ACC_BITMASK, ACC_AREA };
@@ -72,10 +78,12 @@ enum { CLASS_LIT, CLASS_UMBRA, CLASS_BACKPROJECTED }; /* aux `class` */
 /* Plain perspective faces only (softmap.h): no warps or frustum-face splits. */
 #define BP_PARAMS                                                                                                 \
     SMAP_MAP_PARAMS_UPTO(MAP_PROJ_CUBE, LIGHTVIEW_MAX_CASCADES, SPLIT_EXPLICIT), SMAP_BIAS_PARAMS_PLANE(1),        \
-    {"occluder", PARAM_ENUM, OCC_MICROQUAD, 0, 2, "",                                                              \
+    {"occluder", PARAM_ENUM, OCC_MICROQUAD, 0, 3, "",                                                              \
      "occluder representation (course §5.2.3.3): micropatch (each lexel's square at its depth: over-occludes, "   \
      "keeps one-texel twigs), microquad (quads of 2 x 2 lexel centres, all four in front: no gaps, misses "        \
-     "one-texel twigs; the course's recommendation with bitmasks) or microtri (also triangles of three of four)",  \
+     "one-texel twigs; the course's recommendation with bitmasks), microtri (also triangles of three of four) "   \
+     "or contour (Guennebaud 2007: the blocking lexels' outline by a 16-case edge table, each edge's signed "      \
+     "radial area about the light's centre summed; no overlaps, no gaps; pops where the outline changes)",        \
      occluder_names},                                                                                              \
     {"gaps", PARAM_ENUM, GAPS_DIAGONAL, 0, 2, "",                                                                  \
      "occluder=micropatch: gap filling (course §5.2.3.3): none (neighbouring patches at different depths leave "   \
@@ -85,7 +93,8 @@ enum { CLASS_LIT, CLASS_UMBRA, CLASS_BACKPROJECTED }; /* aux `class` */
     {"accumulate", PARAM_ENUM, ACC_BITMASK, 0, 1, "",                                                              \
      "bitmask (Schwarz & Stamminger 2007: one bit per light sample, the union of the occluders' masks, V = 1 - "   \
      "popcount / N) or area (course §5.2.3.1: each occluder's share of the light summed, over-occluding where "    \
-     "occluders overlap; shares measured with the same samples)",                                                  \
+     "occluders overlap; shares measured with the same samples; occluder=contour: the loops' exact share by "    \
+     "signed radial areas, bitmask their enclosed samples)",                                                       \
      accumulate_names},                                                                                            \
     {"tiles", PARAM_INT, 8, 1, 16, "tiles",                                                                        \
      "light samples: a tiles x tiles tiling of the 2 x 2 rotated grid (RGSS), N = 4 tiles^2 (8: the course's "     \
@@ -498,11 +507,142 @@ static bool poly_unknown(const Poly *p, bool rect)
     return false;
 }
 
+/* The covered share of the light's samples in mask. */
+static double mask_share(const BpState *st, const uint64_t *mask)
+{
+    int marked = 0;
+    for (int k = 0; k < BP_WORDS; k++) marked += __builtin_popcountll(mask[k]);
+    return (double)marked / st->samples; /* samples = 4 tiles^2 >= 4 */
+}
+
+/* V = 1 - the covered share of the light, clamped to [0, 1]; NaN when an
+ * occluder that may exist is unknown (issue 13 §1), unless the known ones
+ * already cover the whole light (occluders only add: V = 0 either way). */
+static double share_visibility(double covered, bool unknown)
+{
+    if (covered >= 1.0) return 0.0;
+    return unknown ? NAN : 1.0 - nan_clamp(covered, 0.0, 1.0);
+}
+
+/* ---- contour occluders (Guennebaud et al. 2007, course §5.2.3.3) ----------
+ * The binary mask "blocks the receiver" over the search area's lexels is
+ * outlined by marching squares (course §5.2.3.3: "a 2x2 binary window
+ * indexes a table of oriented edges"; [OWN] the 16 cases below). Cell
+ * (a, b) joins the centres of lexels (a, b), (a + 1, b), (a + 1, b + 1),
+ * (a, b + 1), corners 0 to 3 counter-clockwise; side s runs from corner s
+ * to corner s + 1 and, where the mask changes along it, holds a contour
+ * vertex on the two lexels' shared boundary, at the depth of the blocking
+ * one. [OWN] the table: walking the cell's boundary counter-clockwise, an
+ * edge runs from each side where the mask goes from in to out to the next
+ * side where it goes from out to in, so the blocking lexels lie on the
+ * edge's left and every loop turns counter-clockwise about them; the
+ * saddles (cases 5 and 10) join the two blocking corners (no slit between
+ * diagonal neighbours, as Bavoil's diagonal gap filling). Each vertex is
+ * projected back from p onto the light's plane; the loops' covered share
+ * of the light K is the sum of the signed areas of the triangles (light
+ * centre, a, b) cut by K (Green's theorem, radial_area.h): each region
+ * counted once (no micropatch overlaps, no gaps), but the outline is drawn
+ * in 2D on the map: depth steps inside a region are not in it, and its
+ * image changes by whole lexels as lexels enter or leave the mask
+ * (popping, course §5.2.3.3). */
+static const signed char contour_table[16][4] = {
+    {-1, -1, -1, -1}, {0, 3, -1, -1}, {1, 0, -1, -1}, {1, 3, -1, -1}, {2, 1, -1, -1}, {0, 1, 2, 3},
+    {2, 0, -1, -1},   {2, 3, -1, -1}, {3, 2, -1, -1}, {0, 2, -1, -1}, {1, 2, 3, 0},   {1, 2, -1, -1},
+    {3, 1, -1, -1},   {0, 1, -1, -1}, {3, 0, -1, -1}, {-1, -1, -1, -1},
+};
+static const int cell_corner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+/* side s's vertex, in lexels from cell (a, b)'s low lexel edge */
+static const double side_point[4][2] = {{1.0, 0.5}, {1.5, 1.0}, {1.0, 1.5}, {0.5, 1.0}};
+
+/* Does lexel (a, b) of the search area (the window less its border) block
+ * p? *k: its image scale (backproject_light_scale), NaN where its depth is
+ * unknown (it may block: its vertices are then unknown). */
+static bool contour_inside(const Window *w, int a, int b, double *k)
+{
+    if (a < 1 || b < 1 || a > w->w - 2 || b > w->h - 2) return false;
+    double z = win_z(w, a, b);
+    *k = NAN;
+    return isnan(z) || backproject_light_scale(w->p_z, z, k); /* +INFINITY (lit): false */
+}
+
+/* Toggle in mask the samples whose ray toward +x crosses edge a -> b (the
+ * crossing test of poly_contains, one edge at a time): over closed loops
+ * the samples left set are those enclosed an odd number of times. */
+static void toggle_crossings(const FaceSamples *fs, P2 a, P2 b, uint64_t *mask)
+{
+    double ylo = a.y < b.y ? a.y : b.y, yhi = a.y < b.y ? b.y : a.y, xhi = a.x < b.x ? b.x : a.x;
+    if (!(ylo <= -fs->y0 && yhi >= fs->y0 && xhi >= fs->x0)) return; /* no sample of the light left of it */
+    int r0 = grid_cell(ylo, fs->y0, fs->cell_y), r1 = grid_cell(yhi, fs->y0, fs->cell_y);
+    int c1 = grid_cell(xhi, fs->x0, fs->cell_x);
+    for (int row = r0; row <= r1; row++)
+        for (int k = fs->start[row * BP_GRID]; k < fs->start[row * BP_GRID + c1 + 1]; k++) {
+            int s = fs->index[k];
+            double x = fs->x[s], y = fs->y[s];
+            if ((a.y > y) != (b.y > y) && x < a.x + (b.x - a.x) * (y - a.y) / (b.y - a.y)) /* a.y != b.y here */
+                mask[s >> 6] ^= 1ull << (s & 63);
+        }
+}
+
+/* Signed area of triangle (light centre, a, b) cut by the light, as a share
+ * of the light: in the light's own coordinates (M^-1, softmap.h) K is the
+ * unit disk or [-1, 1]^2, and M scales every area by |det M| (a negative
+ * det flips the orientation; an edge-on light, M^-1 = 0, covers nothing). */
+static double radial_share(const SoftLight *L, P2 a, P2 b)
+{
+    P2 ua = {L->Minv[0][0] * a.x + L->Minv[0][1] * a.y, L->Minv[1][0] * a.x + L->Minv[1][1] * a.y};
+    P2 ub = {L->Minv[0][0] * b.x + L->Minv[0][1] * b.y, L->Minv[1][0] * b.x + L->Minv[1][1] * b.y};
+    double det = L->M[0][0] * L->M[1][1] - L->M[0][1] * L->M[1][0];
+    double share = L->square ? tri_square_area(ua, ub) / 4.0 : tri_disk_area(ua, ub, 1.0) / M_PI;
+    return det < 0.0 ? -share : share;
+}
+
+/* The image on the light's plane (world units, face axes) of side s's
+ * vertex in cell (a, b), whose corners' flags and scales are in[], k[]. */
+static P2 contour_vertex(const Window *w, int a, int b, const bool *in, const double *k, int s)
+{
+    int c = in[s] ? s : (s + 1) % 4; /* the side's blocking corner */
+    double x = win_x(w, a + side_point[s][0]), y = win_y(w, b + side_point[s][1]);
+    return (P2){k[c] * (x - w->u), k[c] * (y - w->v)};
+}
+
+/* V of the window's contour loops: accumulate=area their exact covered
+ * share of the light, bitmask the light samples they enclose. */
+static double contour_visibility(const BpState *st, const SoftLight *L, const FaceSamples *fs, const Window *w)
+{
+    uint64_t mask[BP_WORDS] = {0};
+    double share = 0.0;
+    bool unknown = false;
+    for (int b = 0; b < w->h - 1; b++)
+        for (int a = 0; a < w->w - 1; a++) {
+            bool in[4];
+            double k[4];
+            int code = 0;
+            for (int c = 0; c < 4; c++) {
+                in[c] = contour_inside(w, a + cell_corner[c][0], b + cell_corner[c][1], &k[c]);
+                code |= in[c] << c;
+            }
+            for (int e = 0; e < 4 && contour_table[code][e] >= 0; e += 2) {
+                P2 p = contour_vertex(w, a, b, in, k, contour_table[code][e]);
+                P2 q = contour_vertex(w, a, b, in, k, contour_table[code][e + 1]);
+                if (isnan(p.x) || isnan(p.y) || isnan(q.x) || isnan(q.y)) {
+                    unknown = true;
+                    continue;
+                }
+                if (st->accumulate == ACC_AREA)
+                    share += radial_share(L, p, q);
+                else
+                    toggle_crossings(fs, p, q, mask);
+            }
+        }
+    return share_visibility(st->accumulate == ACC_AREA ? share : mask_share(st, mask), unknown);
+}
+
 /* 1 - occluded share of the light's samples over the window; NaN when an
  * occluder that may exist reads a NaN depth (issue 13 §1), unless the known
  * ones already cover every sample (occluders only add: V = 0 either way). */
-static double window_visibility(const BpState *st, const FaceSamples *fs, const Window *w)
+static double window_visibility(const BpState *st, const SoftFace *f, const FaceSamples *fs, const Window *w)
 {
+    if (st->occluder == OCC_CONTOUR) return contour_visibility(st, &f->light, fs, w);
     uint64_t mask[BP_WORDS] = {0};
     long sum = 0;
     bool patch = st->occluder == OCC_MICROPATCH, unknown = false;
@@ -517,10 +657,8 @@ static double window_visibility(const BpState *st, const FaceSamples *fs, const 
             }
             sum += cover(fs, &p, patch, st->accumulate == ACC_AREA ? NULL : mask); /* area: counted, not united */
         }
-    if (st->accumulate == ACC_AREA) return sum >= st->samples ? 0.0 : unknown ? NAN : 1.0 - (double)sum / st->samples;
-    int marked = 0;
-    for (int k = 0; k < BP_WORDS; k++) marked += __builtin_popcountll(mask[k]);
-    return marked == st->samples ? 0.0 : unknown ? NAN : 1.0 - (double)marked / st->samples;
+    if (st->accumulate == ACC_AREA) return share_visibility((double)sum / st->samples, unknown);
+    return share_visibility(mask_share(st, mask), unknown);
 }
 
 /* Visibility of one receiver; *cls its path (aux `class`), *level the budget level read. */
@@ -538,10 +676,11 @@ static float visibility(const BpState *st, const SmapReceiver *r, Window *w, int
     *cls = CLASS_BACKPROJECTED;
     *level = budget_level(st, wi, wj, &t);
     load_window(st, r, wi, wj, *level, w);
-    double v = window_visibility(st, &st->face[r->mc.face], w);
+    const SoftFace *f = &st->sm.face[r->mc.face];
+    double v = window_visibility(st, f, &st->face[r->mc.face], w);
     if (st->blend && t > 0.0) { /* course §5.2.3.5: blending two levels hides the switch */
         load_window(st, r, wi, wj, *level + 1, w);
-        v = (1.0 - t) * v + t * window_visibility(st, &st->face[r->mc.face], w);
+        v = (1.0 - t) * v + t * window_visibility(st, f, &st->face[r->mc.face], w);
     }
     return (float)v;
 }

@@ -61,6 +61,7 @@
 #include "raster/camera_count.h"
 #include "resources/silhouette.h"
 #include "techniques/shadow_volume.h"
+#include "techniques/radial_area.h"
 #include "techniques/soft_shadow_volume.h"
 #include "techniques/technique.h"
 
@@ -115,51 +116,6 @@ static bool all_edges_mode;
 void ssv_set_all_edges(bool on) { all_edges_mode = on; }
 
 /* ---- 2D geometry in the light's plane (origin: the patch centre) ------------ */
-
-typedef struct P2 { double x, y; } P2;
-#define POLY_MAX 8 /* a rectangle cut by three half-planes */
-
-static double cross2(P2 a, P2 b) { return a.x * b.y - a.y * b.x; }
-
-/* Keep the part of the convex polygon where nx x + ny y + off >= 0
- * (Sutherland-Hodgman, one plane). */
-static int clip_half_plane(P2 *poly, int n, double nx, double ny, double off)
-{
-    P2 out[POLY_MAX];
-    int m = 0;
-    for (int i = 0; i < n; i++) {
-        P2 a = poly[i], b = poly[(i + 1) % n];
-        double da = nx * a.x + ny * a.y + off, db = nx * b.x + ny * b.y + off;
-        if (da >= 0.0 && m < POLY_MAX) out[m++] = a;
-        if ((da >= 0.0) != (db >= 0.0) && m < POLY_MAX) {
-            double t = da / (da - db); /* da != db: they have opposite signs */
-            out[m++] = (P2){a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t};
-        }
-    }
-    memcpy(poly, out, sizeof *poly * (size_t)m);
-    return m;
-}
-
-static double angle_between(P2 a, P2 b) { return atan2(cross2(a, b), a.x * b.x + a.y * b.y); }
-
-/* Signed area of triangle (0, a, b) cut by the disk of radius r at 0: the
- * sector where the segment is outside the disk, the triangle where inside
- * (the classic polygon-circle intersection, summed over a polygon's edges). */
-static double tri_disk_area(P2 a, P2 b, double r)
-{
-    double r2 = r * r;
-    P2 d = {b.x - a.x, b.y - a.y};
-    double A = d.x * d.x + d.y * d.y, B = a.x * d.x + a.y * d.y, C = a.x * a.x + a.y * a.y - r2;
-    if (C <= 0.0 && b.x * b.x + b.y * b.y <= r2) return 0.5 * cross2(a, b);
-    double disc = B * B - A * C;
-    if (A <= 0.0 || disc <= 0.0) return 0.5 * r2 * angle_between(a, b);
-    double s = sqrt(disc), t1 = (-B - s) / A, t2 = (-B + s) / A;
-    if (t2 <= 0.0 || t1 >= 1.0) return 0.5 * r2 * angle_between(a, b);
-    t1 = t1 > 0.0 ? t1 : 0.0;
-    t2 = t2 < 1.0 ? t2 : 1.0;
-    P2 p1 = {a.x + d.x * t1, a.y + d.y * t1}, p2 = {a.x + d.x * t2, a.y + d.y * t2};
-    return 0.5 * (r2 * angle_between(a, p1) + cross2(p1, p2) + r2 * angle_between(p2, b));
-}
 
 /* Area of a counter-clockwise convex polygon, cut by the disk (centre o,
  * radius r) when round. */

@@ -6,7 +6,8 @@
  * crosses the occluder's plane farther than the map's texel from its edges;
  * each occluder representation's documented bias is measured (micropatch
  * over-occlusion, gap leaks without gap filling, summed areas over
- * overlaps, microquads losing one-texel twigs). 160 x 120 or smaller. */
+ * overlaps, microquads losing one-texel twigs; contours' exact areas, no
+ * leaks, no overlaps). 160 x 120 or smaller. */
 #include <math.h>
 #include <stdlib.h>
 #include "fixtures.h"
@@ -110,8 +111,9 @@ TEST(test_backprojection_bitmask_exact_for_a_parallel_square)
     CHECK(vs && cls && bvh);
     double dx = soft_map_dx(lab, "backprojection", 256);
     float extent = scene_extent(lab_scene(lab));
-    static const char *const reps[] = {"occluder=micropatch", "occluder=microquad", "occluder=microtri"};
-    for (int rep = 0; rep < 3; rep++) {
+    static const char *const reps[] = {"occluder=micropatch", "occluder=microquad", "occluder=microtri",
+                                       "occluder=contour"};
+    for (int rep = 0; rep < 4; rep++) {
         const char *p[] = {"map_size=256", "budget=64", reps[rep], NULL};
         RenderResult r;
         CHECK(soft_render(lab, "backprojection", p, &r));
@@ -180,7 +182,8 @@ static double reference_shadow_sum(Lab *lab, int samples)
 /* Course §5.2.3.3 on sphere-on-plane (160 x 120, 64-sample reference):
  * micropatches over-occlude (penumbra too dark), without gap filling they
  * leak in the umbra, summed areas over-occlude further where the
- * gap-filled patches overlap; microquads under-occlude (penumbra too light). */
+ * gap-filled patches overlap; microquads under-occlude (penumbra too light);
+ * contours neither leak nor overlap (bitmask and summed areas agree). */
 TEST(test_backprojection_occluder_biases_on_sphere_on_plane)
 {
     Lab *lab = soft_open("sphere-on-plane.lua", NULL);
@@ -188,10 +191,11 @@ TEST(test_backprojection_occluder_biases_on_sphere_on_plane)
     static const char *const runs[][3] = {
         {"occluder=micropatch", "gaps=diagonal", NULL}, {"occluder=micropatch", "gaps=none", NULL},
         {"occluder=micropatch", "accumulate=area", NULL}, {"occluder=microquad", NULL, NULL},
-        {"occluder=microtri", NULL, NULL},
+        {"occluder=microtri", NULL, NULL}, {"occluder=contour", NULL, NULL},
+        {"occluder=contour", "accumulate=area", NULL},
     };
-    Metrics m[5];
-    for (int k = 0; k < 5; k++) {
+    Metrics m[7];
+    for (int k = 0; k < 7; k++) {
         RenderResult r;
         CHECK(soft_render(lab, "backprojection", runs[k], &r));
         CHECK(soft_metrics(lab, &r.visibility, 64, &m[k]));
@@ -209,7 +213,18 @@ TEST(test_backprojection_occluder_biases_on_sphere_on_plane)
               "summed areas no longer over-occlude where patches overlap");
     CHECK_MSG(m[3].region[REGION_PENUMBRA].mean_signed > 0, "microquads no longer under-occlude");
     CHECK(m[4].region[REGION_PENUMBRA].mean_signed < m[3].region[REGION_PENUMBRA].mean_signed);
-    for (int k = 0; k < 5; k++) CHECK(m[k].region[REGION_UMBRA].leak_mean < 0.05 || k == 1);
+    for (int k = 0; k < 7; k++) CHECK(m[k].region[REGION_UMBRA].leak_mean < 0.05 || k == 1);
+    /* contours (Guennebaud 2007): one outline per region, no gaps (leaks a
+     * tenth of gaps=none's at most) and no overlaps (summed areas no darker
+     * than the union by bitmask, unlike micropatches' areas) */
+    for (int k = 5; k < 7; k++)
+        CHECK_MSG(m[k].region[REGION_UMBRA].leak_mean < 0.1 * m[1].region[REGION_UMBRA].leak_mean,
+                  "contour's umbra leaks %.4f", m[k].region[REGION_UMBRA].leak_mean);
+    CHECK_MSG(fabs(m[6].region[REGION_PENUMBRA].mean_signed - m[5].region[REGION_PENUMBRA].mean_signed) < 0.005 &&
+                  m[6].region[REGION_PENUMBRA].mean_signed > m[2].region[REGION_PENUMBRA].mean_signed + 0.02,
+              "contour areas %+.4f against its bitmask %+.4f and micropatch areas %+.4f",
+              m[6].region[REGION_PENUMBRA].mean_signed, m[5].region[REGION_PENUMBRA].mean_signed,
+              m[2].region[REGION_PENUMBRA].mean_signed);
     lab_close(lab);
 }
 
@@ -513,4 +528,58 @@ TEST(test_occlusion_textures_thin_structures_leak)
     CHECK_MSG(kept[1] > 0.5, "an 8-texel strip keeps only %.3f of its occlusion", kept[1]);
     CHECK_MSG(kept[0] < 0.25 * kept[1], "a 0.4-texel strip keeps %.3f of its occlusion (8 texels: %.3f): thin "
               "structures no longer leak", kept[0], kept[1]);
+}
+
+/* Contours with accumulate=area (Guennebaud 2007's signed radial areas,
+ * exact over the light) against the closed form on the square scene: a
+ * receiver may differ only by the light's share within a lexel of the
+ * occluder's projected edges (the outline lies on the covered texels'
+ * boundaries, its corners cut by half a lexel), estimated by the light
+ * samples within that band plus their own quantisation (4 / (8 tiles), as
+ * above); no leak in the umbra: where no light sample lies near an edge
+ * and the closed form is 0, V is 0 to the sum's rounding. */
+TEST(test_backprojection_contour_areas_exact_for_a_parallel_square)
+{
+    Lab *lab = fixture_lab("square.lua", square_scene);
+    CHECK(lab);
+    Error err;
+    const int tiles = 8, N = 4 * tiles * tiles;
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    CHECK(vs && cls);
+    double dx = soft_map_dx(lab, "backprojection", 256);
+    const char *p[] = {"map_size=256", "budget=64", "occluder=contour", "accumulate=area", NULL};
+    RenderResult r;
+    CHECK(soft_render(lab, "backprojection", p, &r));
+    int ground = 0, umbra = 0, off_band = 0;
+    double worst = 0, worst_off_band = 0, worst_umbra = 0;
+    for (int s = 0; s < vs->count; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE || vs->object[s] != 0) continue;
+        vec3 pw = vs->p_world[s];
+        double delta = (1 << (int)r.aux.data[s]) * dx * SQ_OCC_Y * sqrt(2.0);
+        int band = 0;
+        for (int k = 0; k < N; k++) band += fabs(occluder_margin(pw, square_light_point(tiles, k))) <= delta;
+        double v = r.visibility.data[s], exact = square_exact(pw), e = fabs(v - exact);
+        CHECK_MSG(e <= (double)band / N + 4.0 / (8.0 * tiles) + 1e-9,
+                  "sample %d: |contour %.4f - closed form %.4f| beyond the light's share near the edges (%d samples)",
+                  s, v, exact, band);
+        ground++;
+        worst = fmax(worst, e);
+        if (band == 0) {
+            off_band++;
+            worst_off_band = fmax(worst_off_band, e);
+        }
+        if (band == 0 && exact == 0.0) {
+            umbra++;
+            worst_umbra = fmax(worst_umbra, v);
+        }
+    }
+    printf("    contour, area: %d ground samples; |V - closed form| max %.4f, %.2e where no light sample lies within "
+           "a lexel of an edge (%d); umbra (%d) max V %.2e\n",
+           ground, worst, worst_off_band, off_band, umbra, worst_umbra);
+    CHECK(off_band > ground / 2 && umbra > 50);
+    CHECK_MSG(worst_off_band < 1e-9, "contour areas off the edges' band %.2e from the closed form", worst_off_band);
+    CHECK_MSG(worst_umbra < 1e-12, "contour leaks %.2e in the umbra", worst_umbra); /* the sum's rounding only */
+    render_result_free(&r);
+    lab_close(lab);
 }
