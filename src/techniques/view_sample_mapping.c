@@ -11,12 +11,14 @@
  *
  * Light samples are the reference's own (same pattern, seed, count and
  * stream), so the bitmask is the reference's rays' answers, bit for bit, up
- * to float at edges: the masks are computed exactly per sample (double
- * orientation tests on the projected sample points) rather than read from a
- * Hough-parametrised table (Eisemann & Décoret's quantised lookup), so there
- * is no quantisation error; `near_edge` (aux) counts the light samples within
- * EXACT_AMBIGUOUS_TAN of a projected edge, where the ray test and the mask
- * may disagree.
+ * to float at edges. With masks=exact (the default) the masks are computed
+ * exactly per sample (double orientation tests on the projected sample
+ * points), with no quantisation error; with masks=hough each edge's mask is
+ * that of its line quantised to the nearest bin of a hough_bins x hough_bins
+ * table (angle x offset, Eisemann & Décoret's left-sample map; hough_line),
+ * which errs on the samples between an edge and its quantised line.
+ * `near_edge` (aux) counts the light samples within EXACT_AMBIGUOUS_TAN of a
+ * projected (exact) edge, where the ray test and the exact mask may disagree.
  *
  * Influence region: the view samples are taken in tiles of TILE; a chunk of
  * triangles maps onto the samples of the tile whose cone toward the light
@@ -45,10 +47,28 @@
  * within EXACT_AMBIGUOUS_TAN of an edge is near it (hide_samples) */
 #define NEAR_PAD (2.0 * EXACT_AMBIGUOUS_TAN)
 
+enum { VSM_P_MASKS = EXACT_NUM_SAMPLE_PARAMS, VSM_P_HOUGH_BINS };
+enum { VSM_MASKS_EXACT, VSM_MASKS_HOUGH };
+static const char *const vsm_mask_names[] = {"exact", "hough", NULL};
+
 static const ParamDesc vsm_params[] = {
     EXACT_SAMPLE_PARAMS(32, 256,
                         "N: bits of each view sample's light-sample mask (the course's 32 to 1024); the "
                         "reference's --samples gives the same points"),
+    {"masks", PARAM_ENUM, VSM_MASKS_EXACT, 0, 1, "",
+     "each edge's light-sample mask: exact (orientation test per sample, the reference's answers) or hough (the "
+     "mask of the edge's line quantised to the nearest bin of an angle x offset table, course §5.3.3.2)",
+     vsm_mask_names},
+    {"hough_bins", PARAM_INT, 256, 64, 1048576, "bins per axis",
+     "masks=hough's table resolution: bins of the line angle over [-pi, pi) and of its offset over the kept "
+     "samples' radius about the light frame's centre (the course's 64 to 1024; entries are evaluated when "
+     "fetched, not stored, so up to 2^20); finer bins err on fewer samples",
+     NULL},
+};
+
+static const ParamCondition vsm_conditions[] = {
+    {"hough_bins", "masks=hough"},
+    {NULL, NULL},
 };
 
 static const char *const vsm_resources[] = {"embree_bvh", "silhouette", NULL};
@@ -59,6 +79,8 @@ typedef struct Mapped {
     int s;           /* view sample */
     bool reached;    /* some caster reaches the light's cone from it */
     int open;        /* kept light samples no triangle hides yet: 0 ends the mapping onto it (umbra) */
+    int hough_bins;     /* masks=hough: bins per axis of the quantised lines; 0: masks=exact */
+    double hough_range; /* masks=hough: the offset axis spans [-range, range] (normalised frame) */
     LightPoints lp;
     uint64_t blocked[WORDS], near[WORDS];
     /* The kept samples binned in a GRID x GRID grid over their bounds lo..hi
@@ -71,6 +93,7 @@ typedef struct Mapped {
 } Mapped;
 
 typedef struct VsmState {
+    int hough_bins; /* masks=hough: bins per axis; 0: masks=exact */
     float *vis;  /* per view sample */
     float *near; /* per view sample: light samples within EXACT_AMBIGUOUS_TAN of a projected edge */
 } VsmState;
@@ -101,6 +124,35 @@ static void bin_samples(Mapped *m)
         if (lp->above[i]) m->cell_sample[m->cell_first[cell[i]] + fill[cell[i]]++] = i;
 }
 
+/* masks=hough: a line of the normalised light frame as its quantised Hough
+ * pair (course §5.3.3.2 step 3; Eisemann & Décoret 2007, "Visibility
+ * sampling on GPU and applications"; Sintorn, Eisemann & Assarsson 2008,
+ * "Sample based visibility for soft shadows using alias-free shadow maps",
+ * CGF 27(4) 1285-1292): the unit normal n = (cos theta, sin theta) on the
+ * left of a -> b and the signed offset r = n . a of the line from the frame's
+ * centre (the light's centre direction), so the samples on its left are
+ * those with n . x > r. theta is rounded to the nearest of `bins` angles
+ * -pi + k 2 pi / bins (the table's REPEAT axis), r to the nearest of `bins`
+ * offset bin centres over [-range, range] (CLAMP: past the kept samples'
+ * radius the mask is all or none, as the unclamped line's). A zero-length
+ * edge has no left side: r = +inf, an empty mask, as the exact test's. */
+typedef struct HoughLine {
+    double nx, ny, r; /* normalised frame */
+} HoughLine;
+
+static HoughLine hough_line(P2 a, P2 b, int bins, double range)
+{
+    double dx = b.x - a.x, dy = b.y - a.y, len = hypot(dx, dy);
+    if (!(len > 0.0)) return (HoughLine){1.0, 0.0, INFINITY};
+    double theta = atan2(dx / len, -dy / len), r = (-dy * a.x + dx * a.y) / len;
+    double step_theta = 2.0 * M_PI / bins, step_r = 2.0 * range / bins;
+    long kt = lround((theta + M_PI) / step_theta) % bins;
+    double kr = floor((r + range) / step_r); /* the bin holding r: its centre is the nearest */
+    kr = kr < 0.0 ? 0.0 : kr > bins - 1 ? bins - 1 : kr;
+    double theta_q = -M_PI + (double)kt * step_theta;
+    return (HoughLine){cos(theta_q), sin(theta_q), -range + (kr + 0.5) * step_r};
+}
+
 /* The light samples inside the clipped, projected polygon q[0..np) (bounds
  * lo..hi): those strictly on the inner side of every edge, ORed into the
  * view sample's bitmask; samples on an edge within the tolerance are marked
@@ -112,9 +164,20 @@ static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 
 {
     const LightPoints *lp = &m->lp;
     double len[4];
-    for (int e = 0; e < np; e++) len[e] = hypot(q[(e + 1) % np].x - q[e].x, q[(e + 1) % np].y - q[e].y);
+    HoughLine hl[4];
+    for (int e = 0; e < np; e++) {
+        P2 a = q[e], b = q[(e + 1) % np];
+        len[e] = hypot(b.x - a.x, b.y - a.y);
+        if (m->hough_bins) /* the inner side on the left: b -> a where the polygon turns clockwise */
+            hl[e] = orientation > 0.0 ? hough_line(a, b, m->hough_bins, m->hough_range)
+                                      : hough_line(b, a, m->hough_bins, m->hough_range);
+    }
     int x0 = cell_of(lo.x - NEAR_PAD, lp->lo.x, m->scale_x), x1 = cell_of(hi.x + NEAR_PAD, lp->lo.x, m->scale_x);
     int y0 = cell_of(lo.y - NEAR_PAD, lp->lo.y, m->scale_y), y1 = cell_of(hi.y + NEAR_PAD, lp->lo.y, m->scale_y);
+    if (m->hough_bins) { /* the quantised lines' polygon is not within the bounds (a sliver's tip moves far) */
+        x0 = y0 = 0;
+        x1 = y1 = GRID - 1;
+    }
     for (int cy = y0; cy <= y1; cy++)
         for (int k = m->cell_first[cy * GRID + x0]; k < m->cell_first[cy * GRID + x1 + 1]; k++) {
             int i = m->cell_sample[k];
@@ -124,7 +187,7 @@ static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 
             for (int e = 0; e < np; e++) {
                 P2 a = q[e], b = q[(e + 1) % np];
                 double o = exact_orient(a, b, lp->x[i]) * orientation; /* > 0: the inner side */
-                inside &= o > 0.0;
+                inside &= m->hough_bins ? hl[e].nx * lp->x[i].x + hl[e].ny * lp->x[i].y > hl[e].r : o > 0.0;
                 if (fabs(o) <= EXACT_AMBIGUOUS_TAN * len[e]) {
                     double t = ((lp->x[i].x - a.x) * (b.x - a.x) + (lp->x[i].y - a.y) * (b.y - a.y)) /
                                (len[e] * len[e]);
@@ -153,10 +216,22 @@ static void map_triangle(Mapped *m, const vec3 *tri, bool front_only)
         hi = (P2){fmax(hi.x, q[k].x), fmax(hi.y, q[k].y)};
     }
     const LightPoints *lp = &m->lp;
-    if (hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y) return; /* misses every sample */
+    bool misses = hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y;
+    if (misses && !m->hough_bins) return; /* misses every sample (its quantised lines may not) */
     for (int k = 1; k + 1 < np; k++) area += exact_orient(q[0], q[k], q[k + 1]);
     if (area == 0.0) return;
     hide_samples(m, q, np, area > 0.0 ? 1.0 : -1.0, lo, hi);
+}
+
+/* masks=hough's offset range: the kept samples' largest distance from the
+ * frame's centre (normalised frame), at least EXACT_AMBIGUOUS_TAN so the
+ * bins have a width. */
+static double hough_range(const LightPoints *lp)
+{
+    double range = EXACT_AMBIGUOUS_TAN;
+    for (int i = 0; i < lp->n; i++)
+        if (lp->above[i]) range = fmax(range, hypot(lp->x[i].x, lp->x[i].y) * (1.0 + 1e-9));
+    return range;
 }
 
 /* Kept light samples whose bit in mask is `set`. */
@@ -180,6 +255,8 @@ static void map_tile(const ExactCasters *cs, const TechContext *ctx, Mapped *til
             bin_samples(m);
         }
         m->open = m->reached ? m->lp.kept : 0;
+        m->hough_bins = st->hough_bins;
+        m->hough_range = m->reached ? hough_range(&m->lp) : 0.0;
     }
     bool in[TILE], front_only[TILE];
     for (int o = 0; o < cs->num_objects; o++) {
@@ -245,6 +322,7 @@ static bool vsm_prepare(const TechContext *ctx, void **state, Error *err)
     ExactCasters cs;
     if (!exact_casters_init(ctx, false, &cs, err)) return false;
     VsmState *st = calloc(1, sizeof *st);
+    if (st) st->hough_bins = ctx->params[VSM_P_MASKS] == VSM_MASKS_HOUGH ? (int)ctx->params[VSM_P_HOUGH_BINS] : 0;
     bool ok = st && (st->vis = malloc(sizeof *st->vis * (size_t)ctx->vs->count)) &&
               (st->near = malloc(sizeof *st->near * (size_t)ctx->vs->count));
     if (!ok) error_set(err, "out of memory for %d view samples' masks", ctx->vs->count);
@@ -277,6 +355,7 @@ const Technique tech_view_sample_mapping = {
                "samples",
     .params = vsm_params,
     .num_params = (int)(sizeof vsm_params / sizeof vsm_params[0]),
+    .conditions = vsm_conditions,
     .resources = vsm_resources,
     .rgb = false,
     .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK),
