@@ -46,6 +46,7 @@
 /* normalised-frame distance a triangle's bounds are widened by: a sample
  * within EXACT_AMBIGUOUS_TAN of an edge is near it (hide_samples) */
 #define NEAR_PAD (2.0 * EXACT_AMBIGUOUS_TAN)
+#define HOUGH_FAR 1e300 /* normalised-frame bounds that hold every sample (finite: cell_of's product) */
 
 enum { VSM_P_MASKS = EXACT_NUM_SAMPLE_PARAMS, VSM_P_HOUGH_BINS };
 enum { VSM_MASKS_EXACT, VSM_MASKS_HOUGH };
@@ -133,33 +134,65 @@ static void bin_samples(Mapped *m)
  * centre (the light's centre direction), so the samples on its left are
  * those with n . x > r. theta is rounded to the nearest of `bins` angles
  * -pi + k 2 pi / bins (the table's REPEAT axis), r to the nearest of `bins`
- * offset bin centres over [-range, range] (CLAMP: past the kept samples'
- * radius the mask is all or none, as the unclamped line's). A zero-length
- * edge has no left side: r = +inf, an empty mask, as the exact test's. */
+ * offsets -range + k 2 range / (bins - 1) (CLAMP: range exceeds every kept
+ * sample's distance from the centre, so the end bins' masks are none and
+ * all, as those of the lines past them). A zero-length or non-finite edge
+ * has no left side: r = +inf, an empty mask, as the exact test's. */
 typedef struct HoughLine {
     double nx, ny, r; /* normalised frame */
 } HoughLine;
 
 static HoughLine hough_line(P2 a, P2 b, int bins, double range)
 {
-    double dx = b.x - a.x, dy = b.y - a.y, len = hypot(dx, dy);
-    if (!(len > 0.0)) return (HoughLine){1.0, 0.0, INFINITY};
-    double theta = atan2(dx / len, -dy / len), r = (-dy * a.x + dx * a.y) / len;
-    double step_theta = 2.0 * M_PI / bins, step_r = 2.0 * range / bins;
+    double dx = b.x - a.x, dy = b.y - a.y, len = hypot(dx, dy), r = (-dy * a.x + dx * a.y) / len;
+    if (!(len > 0.0) || !isfinite(r)) return (HoughLine){1.0, 0.0, INFINITY};
+    double theta = atan2(dx / len, -dy / len), step_theta = 2.0 * M_PI / bins, step_r = 2.0 * range / (bins - 1);
     long kt = lround((theta + M_PI) / step_theta) % bins;
-    double kr = floor((r + range) / step_r); /* the bin holding r: its centre is the nearest */
-    kr = kr < 0.0 ? 0.0 : kr > bins - 1 ? bins - 1 : kr;
+    double t = (r + range) / step_r;
+    double kr = t <= 0.0 ? 0.0 : t >= bins - 1 ? bins - 1 : (double)lround(t);
     double theta_q = -M_PI + (double)kt * step_theta;
-    return (HoughLine){cos(theta_q), sin(theta_q), -range + (kr + 0.5) * step_r};
+    return (HoughLine){cos(theta_q), sin(theta_q), -range + kr * step_r};
+}
+
+/* masks=hough: widens the polygon's bounds lo..hi to those of the polygon
+ * with each edge pushed out by delta = pi range / bins + range / (bins - 1),
+ * the most a quantised line's n . x - r moves from the edge's at a sample
+ * (|n_q - n| <= the angle's half bin, |x| < range; the offset's half bin; a
+ * clamped line's mask is the edge's own), so no sample outside them is
+ * inside every quantised line. Corner k moves by the miter delta (n1 + n2) /
+ * (1 + n1 . n2) of its edges' outward unit normals; where that blows up (a
+ * spike) or an edge has no normal, the bounds become the whole plane. */
+static void hough_bounds(const P2 *q, int np, double orientation, int bins, double range, P2 *lo, P2 *hi)
+{
+    double delta = M_PI * range / bins + range / (bins - 1);
+    P2 out[4]; /* per edge: its outward unit normal */
+    for (int e = 0; e < np; e++) {
+        double dx = q[(e + 1) % np].x - q[e].x, dy = q[(e + 1) % np].y - q[e].y, len = hypot(dx, dy);
+        out[e] = (P2){dy / len * orientation, -dx / len * orientation}; /* right of a -> b when it turns left */
+    }
+    *lo = (P2){INFINITY, INFINITY};
+    *hi = (P2){-INFINITY, -INFINITY};
+    for (int k = 0; k < np; k++) {
+        P2 n1 = out[(k + np - 1) % np], n2 = out[k];
+        double cosine = 1.0 + n1.x * n2.x + n1.y * n2.y; /* > 0 unless the edges fold back */
+        if (!(cosine > 1e-12)) {
+            *lo = (P2){-HOUGH_FAR, -HOUGH_FAR};
+            *hi = (P2){HOUGH_FAR, HOUGH_FAR};
+            return;
+        }
+        P2 c = {q[k].x + delta * (n1.x + n2.x) / cosine, q[k].y + delta * (n1.y + n2.y) / cosine};
+        *lo = (P2){fmin(lo->x, c.x), fmin(lo->y, c.y)};
+        *hi = (P2){fmax(hi->x, c.x), fmax(hi->y, c.y)};
+    }
 }
 
 /* The light samples inside the clipped, projected polygon q[0..np) (bounds
  * lo..hi): those strictly on the inner side of every edge, ORed into the
  * view sample's bitmask; samples on an edge within the tolerance are marked
- * near. Only the samples of the grid cells the bounds (widened by NEAR_PAD)
- * overlap are tested: one outside is outside the polygon and farther than
- * the tolerance from its edges, so the masks are those of testing every
- * sample. */
+ * near. Only the samples of the grid cells the bounds (widened by NEAR_PAD;
+ * with masks=hough, by hough_bounds) overlap are tested: one outside is
+ * outside the polygon and farther than the tolerance from its edges, so the
+ * masks are those of testing every sample. */
 static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 lo, P2 hi)
 {
     const LightPoints *lp = &m->lp;
@@ -174,10 +207,6 @@ static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 
     }
     int x0 = cell_of(lo.x - NEAR_PAD, lp->lo.x, m->scale_x), x1 = cell_of(hi.x + NEAR_PAD, lp->lo.x, m->scale_x);
     int y0 = cell_of(lo.y - NEAR_PAD, lp->lo.y, m->scale_y), y1 = cell_of(hi.y + NEAR_PAD, lp->lo.y, m->scale_y);
-    if (m->hough_bins) { /* the quantised lines' polygon is not within the bounds (a sliver's tip moves far) */
-        x0 = y0 = 0;
-        x1 = y1 = GRID - 1;
-    }
     for (int cy = y0; cy <= y1; cy++)
         for (int k = m->cell_first[cy * GRID + x0]; k < m->cell_first[cy * GRID + x1 + 1]; k++) {
             int i = m->cell_sample[k];
@@ -215,12 +244,13 @@ static void map_triangle(Mapped *m, const vec3 *tri, bool front_only)
         lo = (P2){fmin(lo.x, q[k].x), fmin(lo.y, q[k].y)};
         hi = (P2){fmax(hi.x, q[k].x), fmax(hi.y, q[k].y)};
     }
-    const LightPoints *lp = &m->lp;
-    bool misses = hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y;
-    if (misses && !m->hough_bins) return; /* misses every sample (its quantised lines may not) */
     for (int k = 1; k + 1 < np; k++) area += exact_orient(q[0], q[k], q[k + 1]);
     if (area == 0.0) return;
-    hide_samples(m, q, np, area > 0.0 ? 1.0 : -1.0, lo, hi);
+    double orientation = area > 0.0 ? 1.0 : -1.0;
+    if (m->hough_bins) hough_bounds(q, np, orientation, m->hough_bins, m->hough_range, &lo, &hi);
+    const LightPoints *lp = &m->lp;
+    if (hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y) return; /* misses every sample */
+    hide_samples(m, q, np, orientation, lo, hi);
 }
 
 /* masks=hough's offset range: the kept samples' largest distance from the
