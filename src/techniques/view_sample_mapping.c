@@ -16,7 +16,12 @@
  * points), with no quantisation error; with masks=hough each edge's mask is
  * that of its line quantised to the nearest bin of a hough_bins x hough_bins
  * table (angle x offset, Eisemann & Décoret's left-sample map; hough_line),
- * which errs on the samples between an edge and its quantised line.
+ * which errs on the samples between an edge and its quantised line. The
+ * angle axis (the bins' normals) is a set-up table keyed by hough_bins
+ * (point_table); the entry's mask is evaluated when fetched, not stored,
+ * because the reference draws its own sample set per view sample (stream
+ * sampling_stream(seed, s)), so a stored table would be one per view sample
+ * (hough_bins^2 x N bits each) where the papers share one across the frame.
  * `near_edge` (aux) counts the light samples within EXACT_AMBIGUOUS_TAN of a
  * projected (exact) edge, where the ray test and the exact mask may disagree.
  *
@@ -34,6 +39,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include "resources/standard.h"
 #include "techniques/exact_soft.h"
 
 #define TILE 16 /* view samples mapped together */
@@ -62,8 +68,8 @@ static const ParamDesc vsm_params[] = {
      vsm_mask_names},
     {"hough_bins", PARAM_INT, 256, 64, 1048576, "bins per axis",
      "masks=hough's table resolution: bins of the line angle over [-pi, pi) and of its offset over the kept "
-     "samples' radius about the light frame's centre (the course's 64 to 1024; entries are evaluated when "
-     "fetched, not stored, so up to 2^20); finer bins err on fewer samples",
+     "samples' radius about the light frame's centre (the course's 64 to 1024; masks are evaluated when "
+     "fetched, not stored, so up to 2^20, 8 bytes per angle bin); finer bins err on fewer samples",
      NULL},
 };
 
@@ -72,7 +78,7 @@ static const ParamCondition vsm_conditions[] = {
     {NULL, NULL},
 };
 
-static const char *const vsm_resources[] = {"embree_bvh", "silhouette", NULL};
+static const char *const vsm_resources[] = {"embree_bvh", "silhouette", "point_table", NULL};
 static const char *const vsm_aux[] = {"near_edge", NULL};
 
 /* One view sample of a tile: its light samples and masks. */
@@ -80,7 +86,7 @@ typedef struct Mapped {
     int s;           /* view sample */
     bool reached;    /* some caster reaches the light's cone from it */
     int open;        /* kept light samples no triangle hides yet: 0 ends the mapping onto it (umbra) */
-    int hough_bins;     /* masks=hough: bins per axis of the quantised lines; 0: masks=exact */
+    const PointTable *hough_normals; /* masks=hough: the bins' unit normals (hough_fill_normals); NULL: exact */
     double hough_range; /* masks=hough: the offset axis spans [-range, range] (normalised frame) */
     LightPoints lp;
     uint64_t blocked[WORDS], near[WORDS];
@@ -94,7 +100,7 @@ typedef struct Mapped {
 } Mapped;
 
 typedef struct VsmState {
-    int hough_bins; /* masks=hough: bins per axis; 0: masks=exact */
+    const PointTable *hough_normals; /* masks=hough: the angle axis, a set-up table keyed by the bins; NULL: exact */
     float *vis;  /* per view sample */
     float *near; /* per view sample: light samples within EXACT_AMBIGUOUS_TAN of a projected edge */
 } VsmState;
@@ -142,29 +148,41 @@ typedef struct HoughLine {
     double nx, ny, r; /* normalised frame */
 } HoughLine;
 
-static HoughLine hough_line(P2 a, P2 b, int bins, double range)
+/* The angle axis of the table: bin k's unit normal (cos, sin) of
+ * theta_k = -pi + k 2 pi / n. */
+static void hough_fill_normals(float (*pts)[2], int n)
 {
+    for (int k = 0; k < n; k++) {
+        double theta = -M_PI + 2.0 * M_PI * k / n;
+        pts[k][0] = (float)cos(theta);
+        pts[k][1] = (float)sin(theta);
+    }
+}
+
+static HoughLine hough_line(P2 a, P2 b, const PointTable *normals, double range)
+{
+    int bins = normals->n;
     double dx = b.x - a.x, dy = b.y - a.y, len = hypot(dx, dy), r = (-dy * a.x + dx * a.y) / len;
     if (!(len > 0.0) || !isfinite(r)) return (HoughLine){1.0, 0.0, INFINITY};
     double theta = atan2(dx / len, -dy / len), step_theta = 2.0 * M_PI / bins, step_r = 2.0 * range / (bins - 1);
     long kt = lround((theta + M_PI) / step_theta) % bins;
     double t = (r + range) / step_r;
     double kr = t <= 0.0 ? 0.0 : t >= bins - 1 ? bins - 1 : (double)lround(t);
-    double theta_q = -M_PI + (double)kt * step_theta;
-    return (HoughLine){cos(theta_q), sin(theta_q), -range + kr * step_r};
+    return (HoughLine){normals->pts[kt][0], normals->pts[kt][1], -range + kr * step_r};
 }
 
 /* masks=hough: widens the polygon's bounds lo..hi to those of the polygon
- * with each edge pushed out by delta = pi range / bins + range / (bins - 1),
- * the most a quantised line's n . x - r moves from the edge's at a sample
- * (|n_q - n| <= the angle's half bin, |x| < range; the offset's half bin; a
- * clamped line's mask is the edge's own), so no sample outside them is
+ * with each edge pushed out by delta = (pi / bins + 2^-22) range + range /
+ * (bins - 1), the most a quantised line's n . x - r moves from the edge's at
+ * a sample (|n_q - n| <= the angle's half bin plus the float normal's
+ * rounding, |x| < range; the offset's half bin; a clamped line's mask is the
+ * edge's own), so no sample outside them is
  * inside every quantised line. Corner k moves by the miter delta (n1 + n2) /
  * (1 + n1 . n2) of its edges' outward unit normals; where that blows up (a
  * spike) or an edge has no normal, the bounds become the whole plane. */
 static void hough_bounds(const P2 *q, int np, double orientation, int bins, double range, P2 *lo, P2 *hi)
 {
-    double delta = M_PI * range / bins + range / (bins - 1);
+    double delta = (M_PI / bins + 0x1p-22) * range + range / (bins - 1);
     P2 out[4]; /* per edge: its outward unit normal */
     for (int e = 0; e < np; e++) {
         double dx = q[(e + 1) % np].x - q[e].x, dy = q[(e + 1) % np].y - q[e].y, len = hypot(dx, dy);
@@ -201,9 +219,9 @@ static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 
     for (int e = 0; e < np; e++) {
         P2 a = q[e], b = q[(e + 1) % np];
         len[e] = hypot(b.x - a.x, b.y - a.y);
-        if (m->hough_bins) /* the inner side on the left: b -> a where the polygon turns clockwise */
-            hl[e] = orientation > 0.0 ? hough_line(a, b, m->hough_bins, m->hough_range)
-                                      : hough_line(b, a, m->hough_bins, m->hough_range);
+        if (m->hough_normals) /* the inner side on the left: b -> a where the polygon turns clockwise */
+            hl[e] = orientation > 0.0 ? hough_line(a, b, m->hough_normals, m->hough_range)
+                                      : hough_line(b, a, m->hough_normals, m->hough_range);
     }
     int x0 = cell_of(lo.x - NEAR_PAD, lp->lo.x, m->scale_x), x1 = cell_of(hi.x + NEAR_PAD, lp->lo.x, m->scale_x);
     int y0 = cell_of(lo.y - NEAR_PAD, lp->lo.y, m->scale_y), y1 = cell_of(hi.y + NEAR_PAD, lp->lo.y, m->scale_y);
@@ -216,7 +234,7 @@ static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 
             for (int e = 0; e < np; e++) {
                 P2 a = q[e], b = q[(e + 1) % np];
                 double o = exact_orient(a, b, lp->x[i]) * orientation; /* > 0: the inner side */
-                inside &= m->hough_bins ? hl[e].nx * lp->x[i].x + hl[e].ny * lp->x[i].y > hl[e].r : o > 0.0;
+                inside &= m->hough_normals ? hl[e].nx * lp->x[i].x + hl[e].ny * lp->x[i].y > hl[e].r : o > 0.0;
                 if (fabs(o) <= EXACT_AMBIGUOUS_TAN * len[e]) {
                     double t = ((lp->x[i].x - a.x) * (b.x - a.x) + (lp->x[i].y - a.y) * (b.y - a.y)) /
                                (len[e] * len[e]);
@@ -247,7 +265,7 @@ static void map_triangle(Mapped *m, const vec3 *tri, bool front_only)
     for (int k = 1; k + 1 < np; k++) area += exact_orient(q[0], q[k], q[k + 1]);
     if (area == 0.0) return;
     double orientation = area > 0.0 ? 1.0 : -1.0;
-    if (m->hough_bins) hough_bounds(q, np, orientation, m->hough_bins, m->hough_range, &lo, &hi);
+    if (m->hough_normals) hough_bounds(q, np, orientation, m->hough_normals->n, m->hough_range, &lo, &hi);
     const LightPoints *lp = &m->lp;
     if (hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y) return; /* misses every sample */
     hide_samples(m, q, np, orientation, lo, hi);
@@ -285,7 +303,7 @@ static void map_tile(const ExactCasters *cs, const TechContext *ctx, Mapped *til
             bin_samples(m);
         }
         m->open = m->reached ? m->lp.kept : 0;
-        m->hough_bins = st->hough_bins;
+        m->hough_normals = st->hough_normals;
         m->hough_range = m->reached ? hough_range(&m->lp) : 0.0;
     }
     bool in[TILE], front_only[TILE];
@@ -349,10 +367,15 @@ static bool vsm_prepare(const TechContext *ctx, void **state, Error *err)
         return error_set(err, "%ld lit view samples x samples=%d light samples = %.3g exceed the "
                               "bound of %.3g mask bits per frame; lower -p samples or the image size",
                          lit, (int)ctx->params[EXACT_P_SAMPLES], tests, MAX_SAMPLE_TESTS);
+    const PointTable *normals = NULL;
+    if (ctx->params[VSM_P_MASKS] == VSM_MASKS_HOUGH &&
+        !(normals = res_point_table(ctx->rm, "view_sample_mapping hough normals", hough_fill_normals,
+                                    (int)ctx->params[VSM_P_HOUGH_BINS], err)))
+        return false;
     ExactCasters cs;
     if (!exact_casters_init(ctx, false, &cs, err)) return false;
     VsmState *st = calloc(1, sizeof *st);
-    if (st) st->hough_bins = ctx->params[VSM_P_MASKS] == VSM_MASKS_HOUGH ? (int)ctx->params[VSM_P_HOUGH_BINS] : 0;
+    if (st) st->hough_normals = normals;
     bool ok = st && (st->vis = malloc(sizeof *st->vis * (size_t)ctx->vs->count)) &&
               (st->near = malloc(sizeof *st->near * (size_t)ctx->vs->count));
     if (!ok) error_set(err, "out of memory for %d view samples' masks", ctx->vs->count);
