@@ -247,6 +247,12 @@ static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 
         }
 }
 
+/* Do bounds lo..hi (normalised frame) miss every kept sample? */
+static bool misses_samples(const LightPoints *lp, P2 lo, P2 hi)
+{
+    return hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y;
+}
+
 /* Triangle t backprojected from view sample m into its light frame. */
 static void map_triangle(Mapped *m, const vec3 *tri, bool front_only)
 {
@@ -262,12 +268,14 @@ static void map_triangle(Mapped *m, const vec3 *tri, bool front_only)
         lo = (P2){fmin(lo.x, q[k].x), fmin(lo.y, q[k].y)};
         hi = (P2){fmax(hi.x, q[k].x), fmax(hi.y, q[k].y)};
     }
+    if (!m->hough_normals && misses_samples(&m->lp, lo, hi)) return;
     for (int k = 1; k + 1 < np; k++) area += exact_orient(q[0], q[k], q[k + 1]);
     if (area == 0.0) return;
     double orientation = area > 0.0 ? 1.0 : -1.0;
-    if (m->hough_normals) hough_bounds(q, np, orientation, m->hough_normals->n, m->hough_range, &lo, &hi);
-    const LightPoints *lp = &m->lp;
-    if (hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y) return; /* misses every sample */
+    if (m->hough_normals) { /* the quantised lines' bounds, known once the orientation is */
+        hough_bounds(q, np, orientation, m->hough_normals->n, m->hough_range, &lo, &hi);
+        if (misses_samples(&m->lp, lo, hi)) return;
+    }
     hide_samples(m, q, np, orientation, lo, hi);
 }
 
