@@ -204,6 +204,15 @@ static void hough_bounds(const P2 *q, int np, double orientation, int bins, doub
     }
 }
 
+/* masks=hough: is x on the left of every quantised line (the AND of the
+ * table entries' masks)? */
+static bool hough_inside(const HoughLine *hl, int np, P2 x)
+{
+    bool inside = true;
+    for (int e = 0; e < np; e++) inside &= hl[e].nx * x.x + hl[e].ny * x.y > hl[e].r;
+    return inside;
+}
+
 /* The light samples inside the clipped, projected polygon q[0..np) (bounds
  * lo..hi): those strictly on the inner side of every edge, ORed into the
  * view sample's bitmask; samples on an edge within the tolerance are marked
@@ -216,10 +225,11 @@ static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 
     const LightPoints *lp = &m->lp;
     double len[4];
     HoughLine hl[4];
+    const bool hough = m->hough_normals != NULL; /* a local: the loop's stores to m may alias the field */
     for (int e = 0; e < np; e++) {
         P2 a = q[e], b = q[(e + 1) % np];
         len[e] = hypot(b.x - a.x, b.y - a.y);
-        if (m->hough_normals) /* the inner side on the left: b -> a where the polygon turns clockwise */
+        if (hough) /* the inner side on the left: b -> a where the polygon turns clockwise */
             hl[e] = orientation > 0.0 ? hough_line(a, b, m->hough_normals, m->hough_range)
                                       : hough_line(b, a, m->hough_normals, m->hough_range);
     }
@@ -234,13 +244,14 @@ static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 
             for (int e = 0; e < np; e++) {
                 P2 a = q[e], b = q[(e + 1) % np];
                 double o = exact_orient(a, b, lp->x[i]) * orientation; /* > 0: the inner side */
-                inside &= m->hough_normals ? hl[e].nx * lp->x[i].x + hl[e].ny * lp->x[i].y > hl[e].r : o > 0.0;
+                inside &= o > 0.0;
                 if (fabs(o) <= EXACT_AMBIGUOUS_TAN * len[e]) {
                     double t = ((lp->x[i].x - a.x) * (b.x - a.x) + (lp->x[i].y - a.y) * (b.y - a.y)) /
                                (len[e] * len[e]);
                     if (t >= 0.0 && t <= 1.0) m->near[i / 64] |= bit;
                 }
             }
+            if (hough) inside = hough_inside(hl, np, lp->x[i]);
             if (!inside) continue;
             m->blocked[i / 64] |= bit;
             m->open--;
