@@ -11,12 +11,19 @@
  *
  * Light samples are the reference's own (same pattern, seed, count and
  * stream), so the bitmask is the reference's rays' answers, bit for bit, up
- * to float at edges: the masks are computed exactly per sample (double
- * orientation tests on the projected sample points) rather than read from a
- * Hough-parametrised table (Eisemann & Décoret's quantised lookup), so there
- * is no quantisation error; `near_edge` (aux) counts the light samples within
- * EXACT_AMBIGUOUS_TAN of a projected edge, where the ray test and the mask
- * may disagree.
+ * to float at edges. With masks=exact (the default) the masks are computed
+ * exactly per sample (double orientation tests on the projected sample
+ * points), with no quantisation error; with masks=hough each edge's mask is
+ * that of its line quantised to the nearest bin of a hough_bins x hough_bins
+ * table (angle x offset, Eisemann & Décoret's left-sample map; hough_line),
+ * which errs on the samples between an edge and its quantised line. The
+ * angle axis (the bins' normals) is a set-up table keyed by hough_bins
+ * (point_table); the entry's mask is evaluated when fetched, not stored,
+ * because the reference draws its own sample set per view sample (stream
+ * sampling_stream(seed, s)), so a stored table would be one per view sample
+ * (hough_bins^2 x N bits each) where the papers share one across the frame.
+ * `near_edge` (aux) counts the light samples within EXACT_AMBIGUOUS_TAN of a
+ * projected (exact) edge, where the ray test and the exact mask may disagree.
  *
  * Influence region: the view samples are taken in tiles of TILE; a chunk of
  * triangles maps onto the samples of the tile whose cone toward the light
@@ -32,6 +39,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include "resources/standard.h"
 #include "techniques/exact_soft.h"
 
 #define TILE 16 /* view samples mapped together */
@@ -44,14 +52,33 @@
 /* normalised-frame distance a triangle's bounds are widened by: a sample
  * within EXACT_AMBIGUOUS_TAN of an edge is near it (hide_samples) */
 #define NEAR_PAD (2.0 * EXACT_AMBIGUOUS_TAN)
+#define HOUGH_FAR 1e300 /* normalised-frame bounds that hold every sample (finite: cell_of's product) */
+
+enum { VSM_P_MASKS = EXACT_NUM_SAMPLE_PARAMS, VSM_P_HOUGH_BINS };
+enum { VSM_MASKS_EXACT, VSM_MASKS_HOUGH };
+static const char *const vsm_mask_names[] = {"exact", "hough", NULL};
 
 static const ParamDesc vsm_params[] = {
     EXACT_SAMPLE_PARAMS(32, 256,
                         "N: bits of each view sample's light-sample mask (the course's 32 to 1024); the "
                         "reference's --samples gives the same points"),
+    {"masks", PARAM_ENUM, VSM_MASKS_EXACT, 0, 1, "",
+     "each edge's light-sample mask: exact (orientation test per sample, the reference's answers) or hough (the "
+     "mask of the edge's line quantised to the nearest bin of an angle x offset table, course §5.3.3.2)",
+     vsm_mask_names},
+    {"hough_bins", PARAM_INT, 256, 64, 1048576, "bins per axis",
+     "masks=hough's table resolution: bins of the line angle over [-pi, pi) and of its offset over the kept "
+     "samples' radius about the light frame's centre (the course's 64 to 1024; masks are evaluated when "
+     "fetched, not stored, so up to 2^20, 8 bytes per angle bin); finer bins err on fewer samples",
+     NULL},
 };
 
-static const char *const vsm_resources[] = {"embree_bvh", "silhouette", NULL};
+static const ParamCondition vsm_conditions[] = {
+    {"hough_bins", "masks=hough"},
+    {NULL, NULL},
+};
+
+static const char *const vsm_resources[] = {"embree_bvh", "silhouette", "point_table", NULL};
 static const char *const vsm_aux[] = {"near_edge", NULL};
 
 /* One view sample of a tile: its light samples and masks. */
@@ -59,6 +86,8 @@ typedef struct Mapped {
     int s;           /* view sample */
     bool reached;    /* some caster reaches the light's cone from it */
     int open;        /* kept light samples no triangle hides yet: 0 ends the mapping onto it (umbra) */
+    const PointTable *hough_normals; /* masks=hough: the bins' unit normals (hough_fill_normals); NULL: exact */
+    double hough_range; /* masks=hough: the offset axis spans [-range, range] (normalised frame) */
     LightPoints lp;
     uint64_t blocked[WORDS], near[WORDS];
     /* The kept samples binned in a GRID x GRID grid over their bounds lo..hi
@@ -71,6 +100,7 @@ typedef struct Mapped {
 } Mapped;
 
 typedef struct VsmState {
+    const PointTable *hough_normals; /* masks=hough: the angle axis, a set-up table keyed by the bins; NULL: exact */
     float *vis;  /* per view sample */
     float *near; /* per view sample: light samples within EXACT_AMBIGUOUS_TAN of a projected edge */
 } VsmState;
@@ -101,18 +131,108 @@ static void bin_samples(Mapped *m)
         if (lp->above[i]) m->cell_sample[m->cell_first[cell[i]] + fill[cell[i]]++] = i;
 }
 
+/* masks=hough: a line of the normalised light frame as its quantised Hough
+ * pair (course §5.3.3.2 step 3; Eisemann & Décoret 2007, "Visibility
+ * sampling on GPU and applications"; Sintorn, Eisemann & Assarsson 2008,
+ * "Sample based visibility for soft shadows using alias-free shadow maps",
+ * CGF 27(4) 1285-1292): the unit normal n = (cos theta, sin theta) on the
+ * left of a -> b and the signed offset r = n . a of the line from the frame's
+ * centre (the light's centre direction), so the samples on its left are
+ * those with n . x > r. theta is rounded to the nearest of `bins` angles
+ * -pi + k 2 pi / bins (the table's REPEAT axis), r to the nearest of `bins`
+ * offsets -range + k 2 range / (bins - 1) (CLAMP: range exceeds every kept
+ * sample's distance from the centre, so the end bins' masks are none and
+ * all, as those of the lines past them). A zero-length or non-finite edge
+ * has no left side: r = +inf, an empty mask, as the exact test's. */
+typedef struct HoughLine {
+    double nx, ny, r; /* normalised frame */
+} HoughLine;
+
+/* The angle axis of the table: bin k's unit normal (cos, sin) of
+ * theta_k = -pi + k 2 pi / n. */
+static void hough_fill_normals(float (*pts)[2], int n)
+{
+    for (int k = 0; k < n; k++) {
+        double theta = -M_PI + 2.0 * M_PI * k / n;
+        pts[k][0] = (float)cos(theta);
+        pts[k][1] = (float)sin(theta);
+    }
+}
+
+static HoughLine hough_line(P2 a, P2 b, const PointTable *normals, double range)
+{
+    int bins = normals->n;
+    double dx = b.x - a.x, dy = b.y - a.y, len = hypot(dx, dy), r = (-dy * a.x + dx * a.y) / len;
+    if (!(len > 0.0) || !isfinite(r)) return (HoughLine){1.0, 0.0, INFINITY};
+    double theta = atan2(dx / len, -dy / len), step_theta = 2.0 * M_PI / bins, step_r = 2.0 * range / (bins - 1);
+    long kt = lround((theta + M_PI) / step_theta) % bins;
+    double t = (r + range) / step_r;
+    double kr = t <= 0.0 ? 0.0 : t >= bins - 1 ? bins - 1 : (double)lround(t);
+    return (HoughLine){normals->pts[kt][0], normals->pts[kt][1], -range + kr * step_r};
+}
+
+/* masks=hough: widens the polygon's bounds lo..hi to those of the polygon
+ * with each edge pushed out by delta = (pi / bins + 2^-22) range + range /
+ * (bins - 1), the most a quantised line's n . x - r moves from the edge's at
+ * a sample (|n_q - n| <= the angle's half bin plus the float normal's
+ * rounding, |x| < range; the offset's half bin; a clamped line's mask is the
+ * edge's own), so no sample outside them is
+ * inside every quantised line. Corner k moves by the miter delta (n1 + n2) /
+ * (1 + n1 . n2) of its edges' outward unit normals; where that blows up (a
+ * spike) or an edge has no normal, the bounds become the whole plane. */
+static void hough_bounds(const P2 *q, int np, double orientation, int bins, double range, P2 *lo, P2 *hi)
+{
+    double delta = (M_PI / bins + 0x1p-22) * range + range / (bins - 1);
+    P2 out[4]; /* per edge: its outward unit normal */
+    for (int e = 0; e < np; e++) {
+        double dx = q[(e + 1) % np].x - q[e].x, dy = q[(e + 1) % np].y - q[e].y, len = hypot(dx, dy);
+        out[e] = (P2){dy / len * orientation, -dx / len * orientation}; /* right of a -> b when it turns left */
+    }
+    *lo = (P2){INFINITY, INFINITY};
+    *hi = (P2){-INFINITY, -INFINITY};
+    for (int k = 0; k < np; k++) {
+        P2 n1 = out[(k + np - 1) % np], n2 = out[k];
+        double cosine = 1.0 + n1.x * n2.x + n1.y * n2.y; /* > 0 unless the edges fold back */
+        if (!(cosine > 1e-12)) {
+            *lo = (P2){-HOUGH_FAR, -HOUGH_FAR};
+            *hi = (P2){HOUGH_FAR, HOUGH_FAR};
+            return;
+        }
+        P2 c = {q[k].x + delta * (n1.x + n2.x) / cosine, q[k].y + delta * (n1.y + n2.y) / cosine};
+        *lo = (P2){fmin(lo->x, c.x), fmin(lo->y, c.y)};
+        *hi = (P2){fmax(hi->x, c.x), fmax(hi->y, c.y)};
+    }
+}
+
+/* masks=hough: is x on the left of every quantised line (the AND of the
+ * table entries' masks)? */
+static bool hough_inside(const HoughLine *hl, int np, P2 x)
+{
+    bool inside = true;
+    for (int e = 0; e < np; e++) inside &= hl[e].nx * x.x + hl[e].ny * x.y > hl[e].r;
+    return inside;
+}
+
 /* The light samples inside the clipped, projected polygon q[0..np) (bounds
  * lo..hi): those strictly on the inner side of every edge, ORed into the
  * view sample's bitmask; samples on an edge within the tolerance are marked
- * near. Only the samples of the grid cells the bounds (widened by NEAR_PAD)
- * overlap are tested: one outside is outside the polygon and farther than
- * the tolerance from its edges, so the masks are those of testing every
- * sample. */
+ * near. Only the samples of the grid cells the bounds (widened by NEAR_PAD;
+ * with masks=hough, by hough_bounds) overlap are tested: one outside is
+ * outside the polygon and farther than the tolerance from its edges, so the
+ * masks are those of testing every sample. */
 static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 lo, P2 hi)
 {
     const LightPoints *lp = &m->lp;
     double len[4];
-    for (int e = 0; e < np; e++) len[e] = hypot(q[(e + 1) % np].x - q[e].x, q[(e + 1) % np].y - q[e].y);
+    HoughLine hl[4];
+    const bool hough = m->hough_normals != NULL; /* a local: the loop's stores to m may alias the field */
+    for (int e = 0; e < np; e++) {
+        P2 a = q[e], b = q[(e + 1) % np];
+        len[e] = hypot(b.x - a.x, b.y - a.y);
+        if (hough) /* the inner side on the left: b -> a where the polygon turns clockwise */
+            hl[e] = orientation > 0.0 ? hough_line(a, b, m->hough_normals, m->hough_range)
+                                      : hough_line(b, a, m->hough_normals, m->hough_range);
+    }
     int x0 = cell_of(lo.x - NEAR_PAD, lp->lo.x, m->scale_x), x1 = cell_of(hi.x + NEAR_PAD, lp->lo.x, m->scale_x);
     int y0 = cell_of(lo.y - NEAR_PAD, lp->lo.y, m->scale_y), y1 = cell_of(hi.y + NEAR_PAD, lp->lo.y, m->scale_y);
     for (int cy = y0; cy <= y1; cy++)
@@ -131,10 +251,17 @@ static void hide_samples(Mapped *m, const P2 *q, int np, double orientation, P2 
                     if (t >= 0.0 && t <= 1.0) m->near[i / 64] |= bit;
                 }
             }
+            if (hough) inside = hough_inside(hl, np, lp->x[i]);
             if (!inside) continue;
             m->blocked[i / 64] |= bit;
             m->open--;
         }
+}
+
+/* Do bounds lo..hi (normalised frame) miss every kept sample? */
+static bool misses_samples(const LightPoints *lp, P2 lo, P2 hi)
+{
+    return hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y;
 }
 
 /* Triangle t backprojected from view sample m into its light frame. */
@@ -152,11 +279,26 @@ static void map_triangle(Mapped *m, const vec3 *tri, bool front_only)
         lo = (P2){fmin(lo.x, q[k].x), fmin(lo.y, q[k].y)};
         hi = (P2){fmax(hi.x, q[k].x), fmax(hi.y, q[k].y)};
     }
-    const LightPoints *lp = &m->lp;
-    if (hi.x < lp->lo.x || lo.x > lp->hi.x || hi.y < lp->lo.y || lo.y > lp->hi.y) return; /* misses every sample */
+    if (!m->hough_normals && misses_samples(&m->lp, lo, hi)) return;
     for (int k = 1; k + 1 < np; k++) area += exact_orient(q[0], q[k], q[k + 1]);
     if (area == 0.0) return;
-    hide_samples(m, q, np, area > 0.0 ? 1.0 : -1.0, lo, hi);
+    double orientation = area > 0.0 ? 1.0 : -1.0;
+    if (m->hough_normals) { /* the quantised lines' bounds, known once the orientation is */
+        hough_bounds(q, np, orientation, m->hough_normals->n, m->hough_range, &lo, &hi);
+        if (misses_samples(&m->lp, lo, hi)) return;
+    }
+    hide_samples(m, q, np, orientation, lo, hi);
+}
+
+/* masks=hough's offset range: the kept samples' largest distance from the
+ * frame's centre (normalised frame), at least EXACT_AMBIGUOUS_TAN so the
+ * bins have a width. */
+static double hough_range(const LightPoints *lp)
+{
+    double range = EXACT_AMBIGUOUS_TAN;
+    for (int i = 0; i < lp->n; i++)
+        if (lp->above[i]) range = fmax(range, hypot(lp->x[i].x, lp->x[i].y) * (1.0 + 1e-9));
+    return range;
 }
 
 /* Kept light samples whose bit in mask is `set`. */
@@ -180,6 +322,8 @@ static void map_tile(const ExactCasters *cs, const TechContext *ctx, Mapped *til
             bin_samples(m);
         }
         m->open = m->reached ? m->lp.kept : 0;
+        m->hough_normals = st->hough_normals;
+        m->hough_range = m->reached ? hough_range(&m->lp) : 0.0;
     }
     bool in[TILE], front_only[TILE];
     for (int o = 0; o < cs->num_objects; o++) {
@@ -242,9 +386,15 @@ static bool vsm_prepare(const TechContext *ctx, void **state, Error *err)
         return error_set(err, "%ld lit view samples x samples=%d light samples = %.3g exceed the "
                               "bound of %.3g mask bits per frame; lower -p samples or the image size",
                          lit, (int)ctx->params[EXACT_P_SAMPLES], tests, MAX_SAMPLE_TESTS);
+    const PointTable *normals = NULL;
+    if (ctx->params[VSM_P_MASKS] == VSM_MASKS_HOUGH &&
+        !(normals = res_point_table(ctx->rm, "view_sample_mapping hough normals", hough_fill_normals,
+                                    (int)ctx->params[VSM_P_HOUGH_BINS], err)))
+        return false;
     ExactCasters cs;
     if (!exact_casters_init(ctx, false, &cs, err)) return false;
     VsmState *st = calloc(1, sizeof *st);
+    if (st) st->hough_normals = normals;
     bool ok = st && (st->vis = malloc(sizeof *st->vis * (size_t)ctx->vs->count)) &&
               (st->near = malloc(sizeof *st->near * (size_t)ctx->vs->count));
     if (!ok) error_set(err, "out of memory for %d view samples' masks", ctx->vs->count);
@@ -277,6 +427,7 @@ const Technique tech_view_sample_mapping = {
                "samples",
     .params = vsm_params,
     .num_params = (int)(sizeof vsm_params / sizeof vsm_params[0]),
+    .conditions = vsm_conditions,
     .resources = vsm_resources,
     .rgb = false,
     .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK),
