@@ -55,9 +55,7 @@ static const ParamDesc essm_params[] = {
      "a summed-area table's rounding swamps receivers with c (1 - u) above about 22 (f64); at most 80, inside "
      "fp32's 88.7",
      NULL},
-    {"lit_threshold", PARAM_FLOAT, 1e-4, 1e-9, 0.5, "fraction",
-     "the search window's blocked fraction 1 - q below which the receiver is lit: the blocker mean divides by it",
-     NULL},
+    FILTSOFT_LIT_THRESHOLD_PARAM("blocked fraction 1 - q"),
     {"plane_normalise", PARAM_BOOL, 1, 0, 1, "",
      "divide each window's mean of exp(c z) by the receiver plane's own mean over that window instead of "
      "exp(c d) [OWN]: a receiver tilted to the light, whose deeper texels give ESM terms above 1 (course §4.2.4's "

@@ -41,9 +41,7 @@ static const ParamDesc evssm_params[] = {
     {"exponent_neg", PARAM_FLOAT, 10, 0.1, 80, "1 / normalised depth", "c- of the negative warp -exp(-c- u)", NULL},
     {"min_variance", PARAM_FLOAT, 1e-6, 0, 0.25, "normalised depth^2",
      "lower clamp of each window's variance, scaled by the warp's slope at the receiver as evsm's", NULL},
-    {"lit_threshold", PARAM_FLOAT, 1e-4, 1e-9, 0.5, "fraction",
-     "the search window's blocked fraction 1 - p below which the receiver is lit: the blocker mean divides by it",
-     NULL},
+    FILTSOFT_LIT_THRESHOLD_PARAM("blocked fraction 1 - p"),
 };
 FILTER_CHECK_TABLE(evssm_params);
 

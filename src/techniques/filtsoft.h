@@ -34,6 +34,12 @@
      "an fp32 SAT destroys moment differences)",                                                                   \
      filter_precision_names}
 
+/* The blocked fraction (`fraction`: its name in the technique's estimate,
+ * e.g. "1 - p") below which filtsoft_blocker_mean calls a receiver lit. */
+#define FILTSOFT_LIT_THRESHOLD_PARAM(fraction)                                                                      \
+    {"lit_threshold", PARAM_FLOAT, 1e-4, 1e-9, 0.5, "fraction",                                                      \
+     "the search window's " fraction " below which the receiver is lit: the blocker mean divides by it", NULL}
+
 typedef struct FiltSoft {
     SoftMap sm;
     SmapBias bias;

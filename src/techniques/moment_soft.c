@@ -38,8 +38,7 @@ static const ParamDesc moment_soft_params[] = {
      "alpha of b' = (1 - alpha) b + alpha (0, 0.63, 0, 0.63) in both windows, as msm's: keeps the Hankel matrix "
      "positive definite against rounding; more bias, more light leaking; 1 ignores the map",
      NULL},
-    {"lit_threshold", PARAM_FLOAT, 1e-4, 1e-9, 0.5, "fraction",
-     "the search window's blocked weight G below which the receiver is lit: the blocker mean divides by it", NULL},
+    FILTSOFT_LIT_THRESHOLD_PARAM("blocked weight G"),
 };
 FILTER_CHECK_TABLE(moment_soft_params);
 

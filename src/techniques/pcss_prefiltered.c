@@ -34,9 +34,7 @@ static const ParamDesc pcss_prefiltered_params[] = {
      "lower clamp of each window's variance (vsm's: M2 - M1^2 cancels to noise; 0.25 is the largest variance "
      "depths in [0, 1] can have)",
      NULL},
-    {"lit_threshold", PARAM_FLOAT, 1e-4, 1e-9, 0.5, "fraction",
-     "the search window's blocked fraction 1 - p below which the receiver is lit: the blocker mean divides by it",
-     NULL},
+    FILTSOFT_LIT_THRESHOLD_PARAM("blocked fraction 1 - p"),
 };
 FILTER_CHECK_TABLE(pcss_prefiltered_params);
 

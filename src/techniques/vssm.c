@@ -85,9 +85,7 @@ static const ParamDesc vssm_params[] = {
      "lower clamp of each (sub-)kernel's variance (vsm's: M2 - M1^2 cancels to noise; 0.25 is the largest "
      "variance depths in [0, 1] can have)",
      NULL},
-    {"lit_threshold", PARAM_FLOAT, 1e-4, 1e-9, 0.5, "fraction",
-     "the search window's blocked fraction 1 - P below which the receiver is lit: the blocker mean divides by it",
-     NULL},
+    FILTSOFT_LIT_THRESHOLD_PARAM("blocked fraction 1 - P"),
     {"split_depth", PARAM_INT, 2, 0, VSSM_MAX_SPLIT_DEPTH, "levels",
      "Yang et al. 2010's kernel subdivision: a window whose mean lies at or behind the receiver (Chebyshev's "
      "bound then says 'lit') while the min-max pyramid finds a blocker in it is split into 2 x 2 sub-kernels, "
