@@ -139,8 +139,8 @@ static bool versus(const BenchCommon *c, const char *scene, Lab *lab, const char
     bench_tail(tail, sizeof tail, c->threads);
     snprintf(row, sizeof row, "%s,%ld,%s,%d,%.3f,%.3f,%.3f,%s\n", name, scene_triangles(lab_scene(lab)), other,
              map_size, med[0] * 1e3, med[1] * 1e3, med[2], tail);
-    printf("volumes: %s: shadow_volume %.3f ms, %s%s %.3f ms: ratio %.3f\n", scene, med[0] * 1e3, other,
-           map_size > 0 ? (map_size == 2048 ? " 2048^2" : " 4096^2") : "", med[1] * 1e3, med[2]);
+    printf("volumes: %s: shadow_volume %.3f ms, %s %s %.3f ms: ratio %.3f\n", scene, med[0] * 1e3, other,
+           map_size > 0 ? setting : "", med[1] * 1e3, med[2]);
     return bench_csv_append(path, VOL_HEADER, row, err);
 }
 

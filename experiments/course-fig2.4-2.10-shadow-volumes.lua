@@ -21,6 +21,7 @@
 local sl = require "shadowlab"
 local reproduce = require "shadowlab.reproduce"
 local experiment = require "shadowlab.experiment"
+local records = require "shadowlab.records"
 local figures = dofile(sl.root .. "/experiments/lib/figures.lua")
 
 local args = experiment.parse_args(arg, {
@@ -231,21 +232,8 @@ local rep = reproduce.compare(claims, { out = OUT, title = "Course Figs. 2.4-2.1
 page:text(rep.html)
 page:write()
 
-local function write_csv(name, head, rows)
-  local path = OUT .. "/" .. name
-  local f = assert(io.open(path .. ".tmp", "w"))
-  f:write(table.concat(head, ","), "\n")
-  for _, r in ipairs(rows) do
-    local cells = {}
-    for i, v in ipairs(r) do
-      v = tostring(v)
-      cells[i] = v:find('[,"]') and '"' .. v:gsub('"', '""') .. '"' or v
-    end
-    f:write(table.concat(cells, ","), "\n")
-  end
-  f:close()
-  assert(os.rename(path .. ".tmp", path))
-end
-write_csv("agreement.csv", { "view", "method", "lit_candidates", "shadowed_hard", "disagree", "share" }, agreement_rows)
-write_csv("cost.csv", { "scene", "silhouette_edges", "volume_triangles", "fragments_zpass", "hard_ms", "sm_ms",
-                        "zpass_ms", "zfail_ms", "zpplus_ms", "zfail_over_zpass", "zpplus_over_zpass" }, cost_rows)
+records.write_table(OUT .. "/agreement.csv", { "view", "method", "lit_candidates", "shadowed_hard", "disagree",
+                                              "share" }, agreement_rows)
+records.write_table(OUT .. "/cost.csv", { "scene", "silhouette_edges", "volume_triangles", "fragments_zpass", "hard_ms",
+                                         "sm_ms", "zpass_ms", "zfail_ms", "zpplus_ms", "zfail_over_zpass",
+                                         "zpplus_over_zpass" }, cost_rows)

@@ -20,6 +20,7 @@
 local sl = require "shadowlab"
 local reproduce = require "shadowlab.reproduce"
 local experiment = require "shadowlab.experiment"
+local records = require "shadowlab.records"
 local figures = dofile(sl.root .. "/experiments/lib/figures.lua")
 
 local args = experiment.parse_args(arg, {
@@ -55,7 +56,7 @@ local function difference(run, n)
   return count, off, worst
 end
 
-local rows, records, series = {}, {}, {}
+local rows, runs, series = {}, {}, {} -- runs: the records the plot shows
 local at256 = {}
 for _, scene in ipairs(SCENES) do
   local ok, lab = pcall(sl.open, sl.root .. "/scenes/" .. scene .. ".lua", VIEW)
@@ -77,7 +78,7 @@ for _, scene in ipairs(SCENES) do
         local ref = assert(ref_time[n], "exact-soft-vs-rays: the reference was never computed at this N")
         rows[#rows + 1] = { scene, t, n, count, off, off / count, worst, rec.metrics.penumbra and
                             rec.metrics.penumbra.rmse or 0 / 0, 1e3 * frame, 1e3 * ref, ref / frame }
-        records[#records + 1] = rec
+        runs[#runs + 1] = rec
         pts_err[#pts_err + 1] = { n, 1e3 * frame }
         pts_time[#pts_time + 1] = { n, 1e3 * ref }
         if n == 256 then at256[scene .. " " .. t] = { off = off / count, worst = worst, speed = ref / frame } end
@@ -128,19 +129,12 @@ for i, r in ipairs(rows) do
 end
 page:table({ "scene", "technique", "N", "lit candidates", "off by > 1/N", "share", "largest |error|", "penumbra RMSE",
              "frame ms", "reference ms", "reference / frame" }, shown)
-page:plot("time-vs-samples", { title = "Time against light samples", rows = records, xlabel = "light samples N",
+page:plot("time-vs-samples", { title = "Time against light samples", rows = runs, xlabel = "light samples N",
                                ylabel = "ms", series = series })
 page:text(reproduce.compare(claims, { out = OUT, title = "Exact soft shadows against tracing the same rays",
                                       note = "N = 256; times are medians of 3 evaluations after a warm-up" }).html)
 page:write()
 
-local f = assert(io.open(OUT .. "/rows.csv.tmp", "w"))
-f:write("scene,technique,samples,lit_candidates,off,share_off,max_abs_error,penumbra_rmse,frame_ms,reference_ms,",
-        "reference_over_frame\n")
-for _, r in ipairs(rows) do
-  local cells = {}
-  for i, v in ipairs(r) do cells[i] = tostring(v) end
-  f:write(table.concat(cells, ","), "\n")
-end
-f:close()
-assert(os.rename(OUT .. "/rows.csv.tmp", OUT .. "/rows.csv"))
+records.write_table(OUT .. "/rows.csv", { "scene", "technique", "samples", "lit_candidates", "off", "share_off",
+                                          "max_abs_error", "penumbra_rmse", "frame_ms", "reference_ms",
+                                          "reference_over_frame" }, rows)

@@ -255,6 +255,18 @@ function records.csv_text(columns, rows)
   return table.concat(parts)
 end
 
+-- An experiment's own table: `header` (names) and `rows` (arrays of values,
+-- written as csv_line writes record columns), atomically to `path`.
+function records.write_table(path, header, rows)
+  local parts = { table.concat(header, ",") .. "\n" }
+  for _, r in ipairs(rows) do
+    local f = {}
+    for i = 1, #header do f[i] = csv_field(r[i]) end
+    parts[#parts + 1] = table.concat(f, ",") .. "\n"
+  end
+  sl.write_file(path, table.concat(parts))
+end
+
 ---------------------------------------------------------------- writing
 
 local Writer = {}
