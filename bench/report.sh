@@ -4,41 +4,170 @@
 # commit), the programs that failed (failures.txt), and gnuplot plots (SVG
 # and PNG, with their .gp scripts and .dat data): llvmpipe speed-ups against
 # map size, cost growth per axis, and the thread-scaling curves per technique
-# beside bare Embree's, each with its target or ideal drawn in.
-# Usage: bench/report.sh DIR
+# beside bare Embree's, each with its target or ideal drawn in. Every figure
+# stands beside the baseline's (bench/baseline/README.md), with a summary of
+# what got worse at the top.
+# Usage: bench/report.sh DIR [BASELINE]      DIR/README.md, against BASELINE
+#                                            (default bench/baseline/figures.csv)
+#        bench/report.sh --save DIR BASELINE DIR's figures as the baseline,
+#                                            BASELINE written whole or not at all
 set -eu
+mode=report
+if [ "${1:-}" = --save ]; then
+    [ $# -eq 3 ] || { echo "usage: $0 --save DIR BASELINE" >&2; exit 2; }
+    mode=save; shift
+fi
 dir=${1:-reports/bench}
+baseline=${2:-$(dirname "$0")/baseline/figures.csv}
 md="$dir/README.md"
+[ -d "$dir" ] || { echo "report: $dir: no such folder (the CSVs of a bench run)" >&2; exit 2; }
+# Noise margins, a fraction of the baseline's figure (bench/README.md).
+noise_ratio=${BENCH_NOISE_RATIO:-0.10}
+noise_absolute=${BENCH_NOISE_ABSOLUTE:-0.25}
+for v in "BENCH_NOISE_RATIO=$noise_ratio" "BENCH_NOISE_ABSOLUTE=$noise_absolute"; do
+    echo "${v#*=}" | grep -Eq '^(0|[1-9][0-9]*)?([.][0-9]+)?$' && [ -n "${v#*=}" ] ||
+        { echo "report: ${v%%=*} = '${v#*=}': expected a fraction of the baseline's figure, 0 or more (0.1 is 10%)" >&2; exit 2; }
+done
 
-# table CSV COLUMNS...: a markdown table of the named columns of CSV.
+# The CSV reading shared by every awk below: split_csv (RFC 4180 quotes,
+# doubled quotes inside them), csv_field (quotes a field that needs it),
+# is_number (a finite decimal: "nan", "inf" and empty cells are not figures).
+CSV_AWK='
+function split_csv(line, out,    n, i, c, q, field) {
+    n = 0; field = ""; q = 0
+    for (i = 1; i <= length(line); i++) {
+        c = substr(line, i, 1)
+        if (c == "\"") { if (q && substr(line, i + 1, 1) == "\"") { field = field c; i++ } else q = !q; continue }
+        if (c == "," && !q) { out[++n] = field; field = ""; continue }
+        field = field c
+    }
+    out[++n] = field
+    return n
+}
+function csv_field(s) { if (s !~ /[",]/) return s; gsub(/"/, "\"\"", s); return "\"" s "\"" }
+function is_number(s) { return s ~ /^[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?[0-9]+)?$/ }
+'
+
+# The baseline (bench/baseline/README.md): one row per figure of a stored run,
+# BASE_HEADER's columns; "key" joins the key columns as NAME=VALUE.
+BASE_HEADER="table,key,figure,kind,value,threads,commit,cpu_model,load_1min,date"
+
+# table CSV COLUMNS...: a markdown table of the named columns of CSV, each
+# figure beside the baseline's for the same key. A column is marked by a
+# suffix: NAME:k is part of the row's key (what identifies the measurement:
+# scene, technique, size, threads, settings...; a key that comes again in the
+# same CSV, as growth.csv's map_size when it is also a technique's main
+# parameter, is told apart by its order: "#2"); NAME:KD is a figure of kind
+# K and direction D (+ higher is better, - lower is better):
+#   r  a ratio measured within one run (noise margin 10%: BENCH_NOISE_RATIO),
+#   a  an absolute time, rate or size, compared across runs (margin 25%:
+#      BENCH_NOISE_ABSOLUTE; only on the same cpu_model with neither run
+#      loaded, else "n/c", not comparable),
+#   c  a machine-independent count (margin 0: any change is real).
+# In report mode each figure gets one more column, the baseline's value and
+# new/old with its mark, and the row a "baseline" column (the commit, "new"
+# for a key the baseline lacks, and why its absolute figures do not compare);
+# every comparison goes to $cmp for the summary. In save mode (report.sh
+# --save) each figure goes to $save as a baseline row instead.
 table() {
     f="$dir/$1"; name=$1; shift
-    [ -f "$f" ] || { echo "(not run: $name missing)"; echo; return; }
-    awk -F, -v cols="$*" '
-        function split_csv(line, out,    n, i, c, q, field) {
-            n = 0; field = ""; q = 0
-            for (i = 1; i <= length(line); i++) {
-                c = substr(line, i, 1)
-                if (c == "\"") { q = !q; continue }
-                if (c == "," && !q) { out[++n] = field; field = ""; continue }
-                field = field c
+    if [ ! -f "$f" ]; then
+        [ "$mode" = save ] || { echo "(not run: $name missing)"; echo; }
+        return 0
+    fi
+    awk -v tname="$name" -v cols="$*" -v base="$base_in" -v has_base="$has_base" -v cmp="$cmp" -v save="$save" \
+        -v noise_r="$noise_ratio" -v noise_a="$noise_absolute" "$CSV_AWK"'
+        # A row is loaded when its 1-minute load exceeds its own thread count:
+        # something else ran beside the bench.
+        function loaded(load, threads) { return is_number(load) && is_number(threads) && load + 0 > threads + 0 }
+        # Sets was, change and status for figure c (kind and direction kd) of
+        # the row with key `key`, and records the comparison in cmp. bad is
+        # old/new for a figure where higher is better, new/old otherwise
+        # (above 1: worse); a side at 0 has no ratio, only a direction.
+        function compare(key, c, kd, now, comparable,    old, new, bad, margin) {
+            bad = 0
+            if (!((key, c) in bval)) { was = "-"; change = "new"; status = "new" }
+            else if (!is_number(bval[key, c]) || !is_number(now) || bval[key, c] + 0 < 0 || now + 0 < 0) {
+                was = bval[key, c]; change = "n/a"; status = "n/a"    # empty, non-finite or negative
+            } else {
+                old = bval[key, c] + 0; was = bval[key, c]; new = now + 0
+                if (old == new) { bad = 1; change = "1.000" }
+                else if (old == 0 || new == 0) { bad = (new > old) == (substr(kd, 2, 1) == "-") ? 1e30 : 1e-30; change = new == 0 ? "to 0" : "from 0" }
+                else { bad = substr(kd, 2, 1) == "+" ? old / new : new / old; change = sprintf("%.3f", new / old) }
+                margin = substr(kd, 1, 1) == "r" ? noise_r : substr(kd, 1, 1) == "a" ? noise_a : 0
+                if (substr(kd, 1, 1) == "a" && !comparable) { status = "n/c"; change = change " (n/c)" }
+                else if (bad > 1 + margin) { status = "worse"; change = change " **worse**" }
+                else if (bad < 1 / (1 + margin)) { status = "better"; change = change " better" }
+                else status = "same"
             }
-            out[++n] = field
-            return n
+            printf "%s\t%g\t%s\t%s\t%s\t%s\t%s\t%s\n", status, bad, tname, key, c, was, now, change >> cmp
         }
-        NR == 1 {
-            n = split_csv($0, head); m = split(cols, want, " ")
-            for (k = 1; k <= m; k++) for (i = 1; i <= n; i++) if (head[i] == want[k]) idx[k] = i
+        # The baseline row of figure k of the current row (save mode).
+        function save_figure(key, k) {
+            print csv_field(tname) "," csv_field(key) "," want[k] "," role[k] "," csv_field(f[idx[k]]) "," \
+                  csv_field(f[col["threads"]]) "," csv_field(f[col["commit"]]) "," csv_field(f[col["cpu_model"]]) "," \
+                  csv_field(f[col["load_1min"]]) "," csv_field(f[col["date"]]) >> save
+        }
+        BEGIN {
+            m = split(cols, want, " ")
+            for (k = 1; k <= m; k++) {
+                role[k] = ""
+                if (want[k] ~ /:k$/) { role[k] = "k"; sub(/:k$/, "", want[k]) }
+                else if (want[k] ~ /:[rac][-+]$/) { role[k] = substr(want[k], length(want[k]) - 1); sub(/:[rac][-+]$/, "", want[k]) }
+                figure[k] = role[k] ~ /^[rac]/
+            }
+        }
+        FILENAME == base {
+            if (FNR == 1) { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
+            split_csv($0, b)
+            if (b[bcol["table"]] != tname) next
+            key = b[bcol["key"]]
+            bval[key, b[bcol["figure"]]] = b[bcol["value"]]
+            bcommit[key] = b[bcol["commit"]]; bcpu[key] = b[bcol["cpu_model"]]
+            bload[key] = b[bcol["load_1min"]]; bthreads[key] = b[bcol["threads"]]
+            next
+        }
+        FNR == 1 {
+            n = split_csv($0, head)
+            for (i = 1; i <= n; i++) col[head[i]] = i
+            for (k = 1; k <= m; k++) {
+                idx[k] = col[want[k]]
+                if (!idx[k]) printf "report: note: %s has no column %s\n", tname, want[k] > "/dev/stderr"
+            }
+            if (save != "") next
             line = "|"; sep = "|"
-            for (k = 1; k <= m; k++) { line = line " " want[k] " |"; sep = sep "---|" }
+            for (k = 1; k <= m; k++) {
+                line = line " " want[k] " |"; sep = sep "---|"
+                if (has_base && figure[k]) { line = line " " want[k] " (baseline, new/old) |"; sep = sep "---|" }
+            }
+            if (has_base) { line = line " baseline |"; sep = sep "---|" }
             print line; print sep; next
         }
         {
-            split_csv($0, f); line = "|"
-            for (k = 1; k <= m; k++) line = line " " f[idx[k]] " |"
+            split_csv($0, f); key = ""
+            for (k = 1; k <= m; k++) if (role[k] == "k") key = key (key == "" ? "" : " ") want[k] "=" f[idx[k]]
+            if (++repeat[key] > 1) key = key " #" repeat[key]
+            if (save != "") { for (k = 1; k <= m; k++) if (figure[k]) save_figure(key, k); next }
+            note = ""
+            if (has_base) {
+                if (!(key in bcommit)) note = "new"
+                else {
+                    note = substr(bcommit[key], 1, 7)
+                    if (bcpu[key] != f[col["cpu_model"]]) note = note ", other cpu_model (" bcpu[key] ")"
+                    if (loaded(bload[key], bthreads[key])) note = note ", baseline loaded (" bload[key] ")"
+                    if (loaded(f[col["load_1min"]], f[col["threads"]])) note = note ", loaded now (" f[col["load_1min"]] ")"
+                }
+            }
+            comparable = note !~ /other cpu_model|loaded/
+            line = "|"
+            for (k = 1; k <= m; k++) {
+                line = line " " f[idx[k]] " |"
+                if (has_base && figure[k]) { compare(key, want[k], role[k], f[idx[k]], comparable); line = line " " (status == "new" ? "new" : was ", " change) " |" }
+            }
+            if (has_base) line = line " " note " |"
             print line
-        }' "$f"
-    echo
+        }' "$base_in" "$f"
+    [ "$mode" = save ] || echo
 }
 
 # column CSV NAME...: the named columns, space-separated, for gnuplot.
@@ -123,7 +252,8 @@ plot x with lines dashtype 2 title 'ideal'"
     fi
 }
 
-{
+# The heading: the load during the run and the programs that failed.
+heading() {
     echo "# shadowlab benchmarks"
     echo
     echo "Written by \`make bench\` (bench/run.sh, bench/report.sh); what each figure means and its target"
@@ -137,20 +267,24 @@ plot x with lines dashtype 2 title 'ideal'"
         sed 's/^/    /' "$dir/failures.txt"
         echo
     fi
+}
+
+# One section per bench: its tables (table above says what each column's mark means).
+sections() {
     echo "## 1. Reference throughput against a bare Embree loop (target ratio >= 0.9)"
     echo
     echo "bare_rays_per_s is the fastest of rtcOccluded1, 4, 8, 16 and rtcOccluded1M (incoherent, coherent), named in fastest:"
     echo
-    table reference_throughput.csv scene triangles samples rays fastest bare_rays_per_s reference_rays_per_s ratio occluded1_rays_per_s occluded16_rays_per_s threads load_1min commit
+    table reference_throughput.csv scene:k triangles samples:k rays fastest bare_rays_per_s reference_rays_per_s:a+ ratio:r+ occluded1_rays_per_s occluded16_rays_per_s threads:k load_1min commit
     echo "Seed 002's overhead, single_sample_rt / hard:"
     echo
-    table single_sample_overhead.csv scene radius shadow_ratio ray_tracer_ratio threads load_1min commit
+    table single_sample_overhead.csv scene:k radius:k shadow_ratio:r- ray_tracer_ratio:r- threads:k load_1min commit
     echo "## 2. Against llvmpipe (target speed-up >= 2)"
     echo
     echo "![speed-up over llvmpipe](llvmpipe_depth.svg)"
     echo
-    table llvmpipe_depth.csv scene triangles res llvmpipe_ms shadowlab_ms speedup fill_ms vs_fill coverage_mismatch depth_mismatch max_depth_diff agree threads load_1min commit
-    table llvmpipe_pcf.csv scene width height map_res K llvmpipe_ms shadowlab_ms speedup mae samples_off agree threads load_1min commit
+    table llvmpipe_depth.csv scene:k triangles res:k llvmpipe_ms shadowlab_ms:a- speedup:r+ fill_ms vs_fill:r- coverage_mismatch:c- depth_mismatch max_depth_diff agree threads:k load_1min commit
+    table llvmpipe_pcf.csv scene:k width:k height:k map_res:k K:k llvmpipe_ms shadowlab_ms:a- speedup:r+ mae samples_off:c- agree threads:k load_1min commit
     echo "## 3. Cost growth"
     echo
     echo "Each technique on the scene named in its rows; where it does not handle the scene's light 1, the"
@@ -159,36 +293,115 @@ plot x with lines dashtype 2 title 'ideal'"
     echo "![main parameter](growth_main.svg) ![map size](growth_map_size.svg)"
     echo "![triangles](growth_triangles.svg) ![image size](growth_image_width.svg)"
     echo
-    table growth.csv technique axis value frame_ms eval_ms build_ms resources_built note light threads load_1min
+    table growth.csv technique:k axis:k value:k frame_ms:a- eval_ms build_ms resources_built note light:k threads:k load_1min
     echo "Constant time in K with summed-area tables (target: largest K within 1.2x of the smallest):"
     echo
-    table constant_time.csv technique settings prefilter K_min K_max frame_min_ms frame_max_ms ratio within light threads load_1min
+    table constant_time.csv technique:k settings:k prefilter:k K_min K_max frame_min_ms frame_max_ms:a- ratio:r- within light:k threads:k load_1min
     echo "Constant in the light's size (the prefiltered PCSS family and occlusion textures claim it; pcss grows):"
     echo
-    table light_size.csv technique map_size radius_small radius_large frame_small_ms frame_large_ms ratio within scene threads load_1min
+    table light_size.csv technique:k map_size:k radius_small radius_large frame_small_ms frame_large_ms:a- ratio:r- within scene:k threads:k load_1min
     echo "Machine-independent work per technique (core/counters.h), beside the hand count where one is known:"
     echo
-    table work.csv technique texel_fetches_per_sample rays_per_sample frame_triangles frame_fragments frame_bytes_built hand_rule agrees light
+    table work.csv technique:k texel_fetches_per_sample:c- rays_per_sample:c- frame_triangles frame_fragments frame_bytes_built:c- hand_rule agrees light:k
     echo "## 4. Sweep reuse (target <= 1.1; cached references not retraced)"
     echo
-    table sweep_reuse.csv sweep technique points sweep_ms one_build_ms evals_ms ratio builds reuses within threads load_1min
+    table sweep_reuse.csv sweep:k technique:k points:k sweep_ms:a- one_build_ms evals_ms ratio:r- builds:c- reuses within threads:k load_1min
     echo "## 5. Thread scaling (target >= 1.8 at 2 threads; the reference >= 0.9 of bare Embree's own scaling)"
     echo
     echo "![thread speed-ups](threads_eval.svg)"
     echo
-    table reference_scaling.csv scene rays threads bare_ms_1 bare_ms_n bare_speedup reference_ms_1 reference_ms_n reference_speedup ratio within load_1min
-    table raster_threads.csv scene triangles res threads ms_1 ms_n speedup load_1min
-    table threads_eval.csv technique threads ms_1 ms_n speedup light width height load_1min
+    table reference_scaling.csv scene:k rays:k threads:k bare_ms_1 bare_ms_n bare_speedup reference_ms_1 reference_ms_n:a- reference_speedup:r+ ratio:r+ within load_1min
+    table raster_threads.csv scene:k triangles res:k threads:k ms_1 ms_n:a- speedup:r+ load_1min
+    table threads_eval.csv technique:k threads:k ms_1 ms_n:a- speedup:r+ light:k width:k height:k load_1min
     echo "## 6. Peak memory, 4096^2 maps (target <= 1.2)"
     echo
-    table memory.csv technique map_res peak_rss_mib resources_mib ratio within baseline_rss_mib note light load_1min
+    table memory.csv technique:k map_res:k peak_rss_mib:a- resources_mib ratio:r- within baseline_rss_mib note light:k load_1min
     echo "## 7. Start-up (target: no OpenImageIO, first line under 20 ms)"
     echo
-    table startup.csv command first_line_ms exit_ms loads_openimageio within load_1min
+    table startup.csv command:k first_line_ms:a- exit_ms:a- loads_openimageio within load_1min
     echo "## 8. Geometry (issue 14): silhouette extraction against triangles; shadow volumes against sm and hard"
     echo
-    table silhouette.csv segments triangles silhouette_edges build_ms ns_per_triangle ns_per_triangle_over_smallest threads load_1min
-    table volumes.csv scene triangles versus map_size shadow_volume_ms other_ms ratio threads load_1min commit
-} > "$md"
+    table silhouette.csv segments:k triangles silhouette_edges build_ms ns_per_triangle:a- ns_per_triangle_over_smallest:r- threads:k load_1min
+    table volumes.csv scene:k triangles versus:k map_size:k shadow_volume_ms:a- other_ms ratio:r- threads:k load_1min commit
+}
+
+# summary: the baseline's provenance, then how many figures got worse,
+# better, stayed within the noise, are new or vanished, the worse ones
+# listed worst first (from $cmp, the tables' comparisons).
+summary() {
+    echo "## Against the baseline"
+    echo
+    if [ "$has_base" = 0 ]; then
+        echo "No baseline ($baseline: $base_problem), so nothing is compared. \`make bench-baseline\` keeps a"
+        echo "finished run's figures as one (bench/baseline/README.md)."
+        echo
+        return
+    fi
+    awk -F'\t' -v base="$baseline" -v noise_r="$noise_ratio" -v noise_a="$noise_absolute" "$CSV_AWK"'
+        function range(lo, hi) { return lo == hi ? lo : lo " to " hi }
+        function add(list, item, sep) { return index(sep list sep, sep item sep) ? list : list (list == "" ? "" : sep) item }
+        FILENAME != base { n[$1]++; seen[$3, $4, $5] = 1; total++; next }
+        FNR == 1 { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
+        {
+            split_csv($0, b); rows++
+            commits = add(commits, substr(b[bcol["commit"]], 1, 7), ", "); cpus = add(cpus, b[bcol["cpu_model"]], "; ")
+            threads = add(threads, b[bcol["threads"]], ", ")
+            d = b[bcol["date"]]; if (dlo == "" || d < dlo) dlo = d; if (d > dhi) dhi = d
+            l = b[bcol["load_1min"]] + 0; if (rows == 1 || l < llo) llo = l; if (rows == 1 || l > lhi) lhi = l
+            if (!((b[bcol["table"]], b[bcol["key"]], b[bcol["figure"]]) in seen)) {
+                gone++; vanished[gone] = "| " b[bcol["table"]] " | " b[bcol["key"]] " | " b[bcol["figure"]] " | " b[bcol["value"]] " |"
+            }
+        }
+        END {
+            printf "Baseline `%s`: commit %s, %s, threads %s, %s, load_1min %s (%d figures).\n\n", base, commits, cpus, threads, range(dlo, dhi), range(llo, lhi), rows
+            printf "Of this run'"'"'s %d figures: **%d worse**, %d better, %d within the noise, %d not comparable", total, n["worse"], n["better"], n["same"], n["n/c"]
+            printf " (absolute, another cpu_model or a loaded run), %d without a number on one side, %d new; %d vanished", n["n/a"], n["new"], gone
+            printf " (in the baseline, not in this run).\n\n"
+            printf "Noise margins: %g%% for a ratio measured within one run (r), %g%% for an absolute time, rate or size (a),\n", noise_r * 100, noise_a * 100
+            printf "0 for a machine-independent count (c). Absolute figures compare across runs only on the same cpu_model\n"
+            printf "with neither run loaded (1-minute load above the row'"'"'s threads); elsewhere they are n/c, and the\n"
+            printf "tables'"'"' baseline column says why.\n\n"
+            if (gone) {
+                print "Vanished:"; print ""; print "| table | key | figure | baseline |"; print "|---|---|---|---|"
+                for (i = 1; i <= gone; i++) print vanished[i]
+                print ""
+            }
+        }' "$cmp" "$baseline"
+    if grep -q '^worse' "$cmp"; then
+        echo "Worse, worst first:"
+        echo
+        echo "| table | key | figure | baseline | now | new/old |"
+        echo "|---|---|---|---|---|---|"
+        grep '^worse' "$cmp" | sort -t "$tab" -k2,2gr | awk -F'\t' '{ print "| " $3 " | " $4 " | " $5 " | " $6 " | " $7 " | " $8 " |" }'
+        echo
+    fi
+}
+
+tab=$(printf '\t')
+save='' cmp=/dev/null base_in=/dev/null has_base=0
+if [ "$mode" = save ]; then
+    [ -d "$(dirname "$baseline")" ] || { echo "report: $baseline: its folder does not exist" >&2; exit 2; }
+    save="$baseline.tmp$$"
+    trap 'rm -f "$save"' EXIT
+    echo "$BASE_HEADER" > "$save"
+    sections > /dev/null
+    figures=$(($(wc -l < "$save") - 1))
+    [ "$figures" -gt 0 ] || { echo "report: $dir: no figures to keep as a baseline (no bench CSV there)" >&2; exit 1; }
+    mv "$save" "$baseline"
+    echo "report: baseline $baseline: $figures figures from $dir"
+    exit 0
+fi
+base_problem="absent"
+if [ -f "$baseline" ]; then
+    if [ "$(head -n 1 "$baseline")" = "$BASE_HEADER" ]; then has_base=1 base_in=$baseline
+    else base_problem="line 1 is not the header $BASE_HEADER"; echo "report: $baseline: $base_problem; nothing compared" >&2
+    fi
+fi
+cmp="$dir/compare.tmp$$" body="$dir/body.tmp$$"
+trap 'rm -f "$cmp" "$body" "$md.tmp$$"' EXIT
+: > "$cmp"
+sections > "$body"
+{ heading; summary; cat "$body"; } > "$md.tmp$$"
+mv "$md.tmp$$" "$md"
 plots
 echo "report: $md"
