@@ -62,8 +62,10 @@ BASE_HEADER="table,key,figure,kind,value,threads,commit,cpu_model,load_1min,date
 #   r  a ratio measured within one run (noise margin 10%: BENCH_NOISE_RATIO),
 #   a  an absolute time, rate or size, compared across runs (margin 25%:
 #      BENCH_NOISE_ABSOLUTE; only on the same cpu_model with neither run
-#      loaded, else "n/c", not comparable),
+#      loaded, else "n/c", not comparable; loaded: a 1-minute load above
+#      the row's threads + 1),
 #   c  a machine-independent count (margin 0: any change is real).
+# A table with no figure marked gets no comparison (the summary names it).
 # In report mode each figure gets one more column, the baseline's value and
 # new/old with its mark, and the row a "baseline" column (the commit, "new"
 # for a key the baseline lacks, and why its absolute figures do not compare);
@@ -77,9 +79,9 @@ table() {
     fi
     awk -v tname="$name" -v cols="$*" -v base="$base_in" -v has_base="$has_base" -v cmp="$cmp" -v save="$save" \
         -v noise_r="$noise_ratio" -v noise_a="$noise_absolute" "$CSV_AWK"'
-        # A row is loaded when its 1-minute load exceeds its own thread count:
-        # something else ran beside the bench.
-        function loaded(load, threads) { return is_number(load) && is_number(threads) && load + 0 > threads + 0 }
+        # A row is loaded when its 1-minute load exceeds its own thread count
+        # by more than one: more than one other thread ran beside the bench.
+        function loaded(load, threads) { return is_number(load) && is_number(threads) && load + 0 > threads + 1 }
         # Sets was, change and status for figure c (kind and direction kd) of
         # the row with key `key`, and records the comparison in cmp. bad is
         # old/new for a figure where higher is better, new/old otherwise
@@ -115,7 +117,10 @@ table() {
                 if (want[k] ~ /:k$/) { role[k] = "k"; sub(/:k$/, "", want[k]) }
                 else if (want[k] ~ /:[rac][-+]$/) { role[k] = substr(want[k], length(want[k]) - 1); sub(/:[rac][-+]$/, "", want[k]) }
                 figure[k] = role[k] ~ /^[rac]/
+                figures += figure[k]
             }
+            # A table with no figure marked is shown as it is, and named in the summary.
+            if (!figures && has_base) { printf "unmarked\t0\t%s\n", tname >> cmp; has_base = 0 }
         }
         FILENAME == base {
             if (FNR == 1) { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
@@ -340,6 +345,7 @@ summary() {
     awk -F'\t' -v base="$baseline" -v noise_r="$noise_ratio" -v noise_a="$noise_absolute" "$CSV_AWK"'
         function range(lo, hi) { return lo == hi ? lo : lo " to " hi }
         function add(list, item, sep) { return index(sep list sep, sep item sep) ? list : list (list == "" ? "" : sep) item }
+        FILENAME != base && $1 == "unmarked" { unmarked = add(unmarked, $3, ", "); next }
         FILENAME != base { n[$1]++; seen[$3, $4, $5] = 1; total++; next }
         FNR == 1 { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
         {
@@ -359,8 +365,9 @@ summary() {
             printf " (in the baseline, not in this run).\n\n"
             printf "Noise margins: %g%% for a ratio measured within one run (r), %g%% for an absolute time, rate or size (a),\n", noise_r * 100, noise_a * 100
             printf "0 for a machine-independent count (c). Absolute figures compare across runs only on the same cpu_model\n"
-            printf "with neither run loaded (1-minute load above the row'"'"'s threads); elsewhere they are n/c, and the\n"
+            printf "with neither run loaded (1-minute load above the row'"'"'s threads + 1); elsewhere they are n/c, and the\n"
             printf "tables'"'"' baseline column says why.\n\n"
+            if (unmarked != "") printf "Not compared (no figure marked in report.sh: table COLUMN:KD): %s.\n\n", unmarked
             if (gone) {
                 print "Vanished:"; print ""; print "| table | key | figure | baseline |"; print "|---|---|---|---|"
                 for (i = 1; i <= gone; i++) print vanished[i]
