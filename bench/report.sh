@@ -52,32 +52,54 @@ function is_number(s) { return s ~ /^[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?
 # BASE_HEADER's columns; "key" joins the key columns as NAME=VALUE.
 BASE_HEADER="table,key,figure,kind,value,threads,commit,cpu_model,load_1min,date"
 
-# table CSV COLUMNS...: a markdown table of the named columns of CSV, each
-# figure beside the baseline's for the same key. A column is marked by a
-# suffix: NAME:k is part of the row's key (what identifies the measurement:
-# scene, technique, size, threads, settings...; a key that comes again in the
-# same CSV, as growth.csv's map_size when it is also a technique's main
-# parameter, is told apart by its order: "#2"); NAME:KD is a figure of kind
-# K and direction D (+ higher is better, - lower is better):
+# marks CSV: "KEYS | FIGURES" for the rows of CSV. KEYS are the columns that
+# identify a measurement (scene, technique, size, threads, settings...; a key
+# that comes again in the same CSV, as growth.csv's map_size when it is also
+# a technique's main parameter, is told apart by its order: "#2"). FIGURES
+# are NAME:KD, a figure of kind K and direction D (+ higher is better,
+# - lower is better):
 #   r  a ratio measured within one run (noise margin 10%: BENCH_NOISE_RATIO),
 #   a  an absolute time, rate or size, compared across runs (margin 25%:
 #      BENCH_NOISE_ABSOLUTE; only on the same cpu_model with neither run
 #      loaded, else "n/c", not comparable; loaded: a 1-minute load above
 #      the row's threads + 1),
 #   c  a machine-independent count (margin 0: any change is real).
-# A table with no figure marked gets no comparison (the summary names it).
-# In report mode each figure gets one more column, the baseline's value and
-# new/old with its mark, and the row a "baseline" column (the commit, "new"
-# for a key the baseline lacks, and why its absolute figures do not compare);
-# every comparison goes to $cmp for the summary. In save mode (report.sh
-# --save) each figure goes to $save as a baseline row instead.
+# A CSV not listed here is shown as it is and named in the summary.
+marks() {
+    case $1 in
+    reference_throughput.csv)   echo "scene samples threads | reference_rays_per_s:a+ ratio:r+" ;;
+    single_sample_overhead.csv) echo "scene radius threads | shadow_ratio:r- ray_tracer_ratio:r-" ;;
+    llvmpipe_depth.csv)         echo "scene res threads | shadowlab_ms:a- speedup:r+ vs_fill:r- coverage_mismatch:c-" ;;
+    llvmpipe_pcf.csv)           echo "scene width height map_res K threads | shadowlab_ms:a- speedup:r+ samples_off:c-" ;;
+    growth.csv)                 echo "technique axis value scene light settings threads | frame_ms:a-" ;;
+    constant_time.csv)          echo "technique settings prefilter light threads | frame_max_ms:a- ratio:r-" ;;
+    light_size.csv)             echo "technique map_size scene threads | frame_large_ms:a- ratio:r-" ;;
+    work.csv)                   echo "technique light settings | texel_fetches_per_sample:c- rays_per_sample:c- frame_bytes_built:c-" ;;
+    sweep_reuse.csv)            echo "sweep technique points threads | sweep_ms:a- ratio:r- builds:c-" ;;
+    reference_scaling.csv)      echo "scene rays threads | reference_ms_n:a- reference_speedup:r+ ratio:r+" ;;
+    raster_threads.csv)         echo "scene res threads | ms_n:a- speedup:r+" ;;
+    threads_eval.csv)           echo "technique threads light settings width height | ms_n:a- speedup:r+" ;;
+    memory.csv)                 echo "technique map_res light | peak_rss_mib:a- ratio:r-" ;;
+    startup.csv)                echo "command | first_line_ms:a- exit_ms:a-" ;;
+    silhouette.csv)             echo "segments threads | ns_per_triangle:a- ns_per_triangle_over_smallest:r-" ;;
+    volumes.csv)                echo "scene versus map_size threads | shadow_volume_ms:a- ratio:r-" ;;
+    esac
+}
+
+# table CSV COLUMNS...: a markdown table of the named columns of CSV, each
+# figure (marks) beside the baseline's for the same key: in report mode each
+# figure gets one more column, the baseline's value and new/old with its
+# mark, and the row a "baseline" column (the commit, "new" for a key the
+# baseline lacks, and why its absolute figures do not compare); every
+# comparison goes to $cmp for the summary. In save mode (report.sh --save)
+# each figure goes to $save as a baseline row instead.
 table() {
     f="$dir/$1"; name=$1; shift
     if [ ! -f "$f" ]; then
         [ "$mode" = save ] || { echo "(not run: $name missing)"; echo; }
         return 0
     fi
-    awk -v tname="$name" -v cols="$*" -v base="$base_in" -v has_base="$has_base" -v cmp="$cmp" -v save="$save" \
+    awk -v tname="$name" -v cols="$*" -v marks="$(marks "$name")" -v base="$base_in" -v has_base="$has_base" -v cmp="$cmp" -v save="$save" \
         -v noise_r="$noise_ratio" -v noise_a="$noise_absolute" "$CSV_AWK"'
         # A row is loaded when its 1-minute load exceeds its own thread count
         # by more than one: more than one other thread ran beside the bench.
@@ -110,17 +132,19 @@ table() {
                   csv_field(f[col["threads"]]) "," csv_field(f[col["commit"]]) "," csv_field(f[col["cpu_model"]]) "," \
                   csv_field(f[col["load_1min"]]) "," csv_field(f[col["date"]]) >> save
         }
+        # want[1..m]: the columns shown; role[k] the kind and direction of a
+        # figure (a figure not shown is added at the end); keys[1..nk].
         BEGIN {
             m = split(cols, want, " ")
-            for (k = 1; k <= m; k++) {
-                role[k] = ""
-                if (want[k] ~ /:k$/) { role[k] = "k"; sub(/:k$/, "", want[k]) }
-                else if (want[k] ~ /:[rac][-+]$/) { role[k] = substr(want[k], length(want[k]) - 1); sub(/:[rac][-+]$/, "", want[k]) }
-                figure[k] = role[k] ~ /^[rac]/
-                figures += figure[k]
+            split(marks, part, "[|]"); nk = split(part[1], keys, " "); nf = split(part[2], figs, " ")
+            for (j = 1; j <= nf; j++) {
+                c = figs[j]; sub(/:[rac][-+]$/, "", c)
+                for (k = 1; k <= m && want[k] != c; k++) ;
+                if (k > m) want[++m] = c
+                role[k] = substr(figs[j], length(figs[j]) - 1)
             }
-            # A table with no figure marked is shown as it is, and named in the summary.
-            if (!figures && has_base) { printf "unmarked\t0\t%s\n", tname >> cmp; has_base = 0 }
+            # A table with no figure is shown as it is, and named in the summary.
+            if (!nf && has_base) { printf "unmarked\t0\t%s\n", tname >> cmp; has_base = 0 }
         }
         FILENAME == base {
             if (FNR == 1) { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
@@ -135,24 +159,23 @@ table() {
         FNR == 1 {
             n = split_csv($0, head)
             for (i = 1; i <= n; i++) col[head[i]] = i
-            for (k = 1; k <= m; k++) {
-                idx[k] = col[want[k]]
-                if (!idx[k]) printf "report: note: %s has no column %s\n", tname, want[k] > "/dev/stderr"
-            }
+            for (k = 1; k <= m; k++) idx[k] = col[want[k]]
+            for (k = 1; k <= m; k++) if (!idx[k]) printf "report: note: %s has no column %s\n", tname, want[k] > "/dev/stderr"
+            for (j = 1; j <= nk; j++) if (!col[keys[j]]) printf "report: note: %s has no key column %s\n", tname, keys[j] > "/dev/stderr"
             if (save != "") next
             line = "|"; sep = "|"
             for (k = 1; k <= m; k++) {
                 line = line " " want[k] " |"; sep = sep "---|"
-                if (has_base && figure[k]) { line = line " " want[k] " (baseline, new/old) |"; sep = sep "---|" }
+                if (has_base && (k in role)) { line = line " " want[k] " (baseline, new/old) |"; sep = sep "---|" }
             }
             if (has_base) { line = line " baseline |"; sep = sep "---|" }
             print line; print sep; next
         }
         {
             split_csv($0, f); key = ""
-            for (k = 1; k <= m; k++) if (role[k] == "k") key = key (key == "" ? "" : " ") want[k] "=" f[idx[k]]
+            for (j = 1; j <= nk; j++) key = key (j > 1 ? " " : "") keys[j] "=" f[col[keys[j]]]
             if (++repeat[key] > 1) key = key " #" repeat[key]
-            if (save != "") { for (k = 1; k <= m; k++) if (figure[k]) save_figure(key, k); next }
+            if (save != "") { for (k = 1; k <= m; k++) if (k in role) save_figure(key, k); next }
             note = ""
             if (has_base) {
                 if (!(key in bcommit)) note = "new"
@@ -167,7 +190,7 @@ table() {
             line = "|"
             for (k = 1; k <= m; k++) {
                 line = line " " f[idx[k]] " |"
-                if (has_base && figure[k]) { compare(key, want[k], role[k], f[idx[k]], comparable); line = line " " (status == "new" ? "new" : was ", " change) " |" }
+                if (has_base && (k in role)) { compare(key, want[k], role[k], f[idx[k]], comparable); line = line " " (status == "new" ? "new" : was ", " change) " |" }
             }
             if (has_base) line = line " " note " |"
             print line
@@ -280,16 +303,16 @@ sections() {
     echo
     echo "bare_rays_per_s is the fastest of rtcOccluded1, 4, 8, 16 and rtcOccluded1M (incoherent, coherent), named in fastest:"
     echo
-    table reference_throughput.csv scene:k triangles samples:k rays fastest bare_rays_per_s reference_rays_per_s:a+ ratio:r+ occluded1_rays_per_s occluded16_rays_per_s threads:k load_1min commit
+    table reference_throughput.csv scene triangles samples rays fastest bare_rays_per_s reference_rays_per_s ratio occluded1_rays_per_s occluded16_rays_per_s threads load_1min commit
     echo "Seed 002's overhead, single_sample_rt / hard:"
     echo
-    table single_sample_overhead.csv scene:k radius:k shadow_ratio:r- ray_tracer_ratio:r- threads:k load_1min commit
+    table single_sample_overhead.csv scene radius shadow_ratio ray_tracer_ratio threads load_1min commit
     echo "## 2. Against llvmpipe (target speed-up >= 2)"
     echo
     echo "![speed-up over llvmpipe](llvmpipe_depth.svg)"
     echo
-    table llvmpipe_depth.csv scene:k triangles res:k llvmpipe_ms shadowlab_ms:a- speedup:r+ fill_ms vs_fill:r- coverage_mismatch:c- depth_mismatch max_depth_diff agree threads:k load_1min commit
-    table llvmpipe_pcf.csv scene:k width:k height:k map_res:k K:k llvmpipe_ms shadowlab_ms:a- speedup:r+ mae samples_off:c- agree threads:k load_1min commit
+    table llvmpipe_depth.csv scene triangles res llvmpipe_ms shadowlab_ms speedup fill_ms vs_fill coverage_mismatch depth_mismatch max_depth_diff agree threads load_1min commit
+    table llvmpipe_pcf.csv scene width height map_res K llvmpipe_ms shadowlab_ms speedup mae samples_off agree threads load_1min commit
     echo "## 3. Cost growth"
     echo
     echo "Each technique on the scene named in its rows; where it does not handle the scene's light 1, the"
@@ -298,36 +321,36 @@ sections() {
     echo "![main parameter](growth_main.svg) ![map size](growth_map_size.svg)"
     echo "![triangles](growth_triangles.svg) ![image size](growth_image_width.svg)"
     echo
-    table growth.csv technique:k axis:k value:k frame_ms:a- eval_ms build_ms resources_built note light:k threads:k load_1min
+    table growth.csv technique axis value frame_ms eval_ms build_ms resources_built note light threads load_1min
     echo "Constant time in K with summed-area tables (target: largest K within 1.2x of the smallest):"
     echo
-    table constant_time.csv technique:k settings:k prefilter:k K_min K_max frame_min_ms frame_max_ms:a- ratio:r- within light:k threads:k load_1min
+    table constant_time.csv technique settings prefilter K_min K_max frame_min_ms frame_max_ms ratio within light threads load_1min
     echo "Constant in the light's size (the prefiltered PCSS family and occlusion textures claim it; pcss grows):"
     echo
-    table light_size.csv technique:k map_size:k radius_small radius_large frame_small_ms frame_large_ms:a- ratio:r- within scene:k threads:k load_1min
+    table light_size.csv technique map_size radius_small radius_large frame_small_ms frame_large_ms ratio within scene threads load_1min
     echo "Machine-independent work per technique (core/counters.h), beside the hand count where one is known:"
     echo
-    table work.csv technique:k texel_fetches_per_sample:c- rays_per_sample:c- frame_triangles frame_fragments frame_bytes_built:c- hand_rule agrees light:k
+    table work.csv technique texel_fetches_per_sample rays_per_sample frame_triangles frame_fragments frame_bytes_built hand_rule agrees light
     echo "## 4. Sweep reuse (target <= 1.1; cached references not retraced)"
     echo
-    table sweep_reuse.csv sweep:k technique:k points:k sweep_ms:a- one_build_ms evals_ms ratio:r- builds:c- reuses within threads:k load_1min
+    table sweep_reuse.csv sweep technique points sweep_ms one_build_ms evals_ms ratio builds reuses within threads load_1min
     echo "## 5. Thread scaling (target >= 1.8 at 2 threads; the reference >= 0.9 of bare Embree's own scaling)"
     echo
     echo "![thread speed-ups](threads_eval.svg)"
     echo
-    table reference_scaling.csv scene:k rays:k threads:k bare_ms_1 bare_ms_n bare_speedup reference_ms_1 reference_ms_n:a- reference_speedup:r+ ratio:r+ within load_1min
-    table raster_threads.csv scene:k triangles res:k threads:k ms_1 ms_n:a- speedup:r+ load_1min
-    table threads_eval.csv technique:k threads:k ms_1 ms_n:a- speedup:r+ light:k width:k height:k load_1min
+    table reference_scaling.csv scene rays threads bare_ms_1 bare_ms_n bare_speedup reference_ms_1 reference_ms_n reference_speedup ratio within load_1min
+    table raster_threads.csv scene triangles res threads ms_1 ms_n speedup load_1min
+    table threads_eval.csv technique threads ms_1 ms_n speedup light width height load_1min
     echo "## 6. Peak memory, 4096^2 maps (target <= 1.2)"
     echo
-    table memory.csv technique:k map_res:k peak_rss_mib:a- resources_mib ratio:r- within baseline_rss_mib note light:k load_1min
+    table memory.csv technique map_res peak_rss_mib resources_mib ratio within baseline_rss_mib note light load_1min
     echo "## 7. Start-up (target: no OpenImageIO, first line under 20 ms)"
     echo
-    table startup.csv command:k first_line_ms:a- exit_ms:a- loads_openimageio within load_1min
+    table startup.csv command first_line_ms exit_ms loads_openimageio within load_1min
     echo "## 8. Geometry (issue 14): silhouette extraction against triangles; shadow volumes against sm and hard"
     echo
-    table silhouette.csv segments:k triangles silhouette_edges build_ms ns_per_triangle:a- ns_per_triangle_over_smallest:r- threads:k load_1min
-    table volumes.csv scene:k triangles versus:k map_size:k shadow_volume_ms:a- other_ms ratio:r- threads:k load_1min commit
+    table silhouette.csv segments triangles silhouette_edges build_ms ns_per_triangle ns_per_triangle_over_smallest threads load_1min
+    table volumes.csv scene triangles versus map_size shadow_volume_ms other_ms ratio threads load_1min commit
 }
 
 # summary: the baseline's provenance, then how many figures got worse,
@@ -367,7 +390,7 @@ summary() {
             printf "0 for a machine-independent count (c). Absolute figures compare across runs only on the same cpu_model\n"
             printf "with neither run loaded (1-minute load above the row'"'"'s threads + 1); elsewhere they are n/c, and the\n"
             printf "tables'"'"' baseline column says why.\n\n"
-            if (unmarked != "") printf "Not compared (no figure marked in report.sh: table COLUMN:KD): %s.\n\n", unmarked
+            if (unmarked != "") printf "Not compared (no line in marks() of bench/report.sh): %s.\n\n", unmarked
             if (gone) {
                 print "Vanished:"; print ""; print "| table | key | figure | baseline |"; print "|---|---|---|---|"
                 for (i = 1; i <= gone; i++) print vanished[i]
