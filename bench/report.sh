@@ -297,7 +297,7 @@ heading() {
     fi
 }
 
-# One section per bench: its tables (table above says what each column's mark means).
+# One section per bench: its tables (marks says which columns are keys and figures).
 sections() {
     echo "## 1. Reference throughput against a bare Embree loop (target ratio >= 0.9)"
     echo
@@ -353,9 +353,22 @@ sections() {
     table volumes.csv scene triangles versus map_size shadow_volume_ms other_ms ratio threads load_1min commit
 }
 
+# vanished: the baseline's figures this run has no row for (from $cmp, the
+# tables' comparisons), as markdown rows.
+vanished() {
+    awk -F'\t' -v base="$baseline" "$CSV_AWK"'
+        FILENAME != base { seen[$3, $4, $5] = 1; next }
+        FNR == 1 { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
+        {
+            split_csv($0, b)
+            if (!((b[bcol["table"]], b[bcol["key"]], b[bcol["figure"]]) in seen))
+                print "| " b[bcol["table"]] " | " b[bcol["key"]] " | " b[bcol["figure"]] " | " b[bcol["value"]] " |"
+        }' "$cmp" "$baseline"
+}
+
 # summary: the baseline's provenance, then how many figures got worse,
-# better, stayed within the noise, are new or vanished, the worse ones
-# listed worst first (from $cmp, the tables' comparisons).
+# better, stayed within the noise, are new or vanished, and the worse ones
+# listed worst first, then the vanished ones.
 summary() {
     echo "## Against the baseline"
     echo
@@ -365,11 +378,12 @@ summary() {
         echo
         return
     fi
-    awk -F'\t' -v base="$baseline" -v noise_r="$noise_ratio" -v noise_a="$noise_absolute" "$CSV_AWK"'
+    vanished > "$gone"
+    awk -F'\t' -v base="$baseline" -v gone="$(wc -l < "$gone")" -v noise_r="$noise_ratio" -v noise_a="$noise_absolute" "$CSV_AWK"'
         function range(lo, hi) { return lo == hi ? lo : lo " to " hi }
         function add(list, item, sep) { return index(sep list sep, sep item sep) ? list : list (list == "" ? "" : sep) item }
         FILENAME != base && $1 == "unmarked" { unmarked = add(unmarked, $3, ", "); next }
-        FILENAME != base { n[$1]++; seen[$3, $4, $5] = 1; total++; next }
+        FILENAME != base { n[$1]++; total++; next }
         FNR == 1 { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
         {
             split_csv($0, b); rows++
@@ -377,12 +391,9 @@ summary() {
             threads = add(threads, b[bcol["threads"]], ", ")
             d = b[bcol["date"]]; if (dlo == "" || d < dlo) dlo = d; if (d > dhi) dhi = d
             l = b[bcol["load_1min"]] + 0; if (rows == 1 || l < llo) llo = l; if (rows == 1 || l > lhi) lhi = l
-            if (!((b[bcol["table"]], b[bcol["key"]], b[bcol["figure"]]) in seen)) {
-                gone++; vanished[gone] = "| " b[bcol["table"]] " | " b[bcol["key"]] " | " b[bcol["figure"]] " | " b[bcol["value"]] " |"
-            }
         }
         END {
-            printf "Baseline `%s`: commit %s, %s, threads %s, %s, load_1min %s (%d figures).\n\n", base, commits, cpus, threads, range(dlo, dhi), range(llo, lhi), rows
+            printf "Baseline `%s` (%d figures): commit %s; cpu_model %s; threads %s; %s; load_1min %s.\n\n", base, rows, commits, cpus, threads, range(dlo, dhi), range(llo, lhi)
             printf "Of this run'"'"'s %d figures: **%d worse**, %d better, %d within the noise, %d not comparable", total, n["worse"], n["better"], n["same"], n["n/c"]
             printf " (absolute, another cpu_model or a loaded run), %d without a number on one side, %d new; %d vanished", n["n/a"], n["new"], gone
             printf " (in the baseline, not in this run).\n\n"
@@ -391,11 +402,6 @@ summary() {
             printf "with neither run loaded (1-minute load above the row'"'"'s threads + 1); elsewhere they are n/c, and the\n"
             printf "tables'"'"' baseline column says why.\n\n"
             if (unmarked != "") printf "Not compared (no line in marks() of bench/report.sh): %s.\n\n", unmarked
-            if (gone) {
-                print "Vanished:"; print ""; print "| table | key | figure | baseline |"; print "|---|---|---|---|"
-                for (i = 1; i <= gone; i++) print vanished[i]
-                print ""
-            }
         }' "$cmp" "$baseline"
     if grep -q '^worse' "$cmp"; then
         echo "Worse, worst first:"
@@ -403,6 +409,14 @@ summary() {
         echo "| table | key | figure | baseline | now | new/old |"
         echo "|---|---|---|---|---|---|"
         grep '^worse' "$cmp" | sort -t "$tab" -k2,2gr | awk -F'\t' '{ print "| " $3 " | " $4 " | " $5 " | " $6 " | " $7 " | " $8 " |" }'
+        echo
+    fi
+    if [ -s "$gone" ]; then
+        echo "Vanished:"
+        echo
+        echo "| table | key | figure | baseline |"
+        echo "|---|---|---|---|"
+        cat "$gone"
         echo
     fi
 }
@@ -427,8 +441,8 @@ if [ -f "$baseline" ]; then
     else base_problem="line 1 is not the header $BASE_HEADER"; echo "report: $baseline: $base_problem; nothing compared" >&2
     fi
 fi
-cmp="$dir/compare.tmp$$" body="$dir/body.tmp$$"
-trap 'rm -f "$cmp" "$body" "$md.tmp$$"' EXIT
+cmp="$dir/compare.tmp$$" body="$dir/body.tmp$$" gone="$dir/gone.tmp$$"
+trap 'rm -f "$cmp" "$body" "$gone" "$md.tmp$$"' EXIT
 : > "$cmp"
 sections > "$body"
 { heading; summary; cat "$body"; } > "$md.tmp$$"

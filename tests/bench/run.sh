@@ -70,6 +70,7 @@ set -- "$TMP"/*.tmp[0-9]*
 # The comparison.
 expect "compare: report written" 0 "report:" -- "$ROOT/bench/report.sh" "$TMP/new" "$base"
 md=$TMP/new/README.md
+has "compare: baseline's provenance" "$md" "(8 figures): commit aaaaaaa; cpu_model Test CPU, 2 cores; threads 1, 2;"
 has "compare: summary counts" "$md" "Of this run's 8 figures: **2 worse**, 0 better, 3 within the noise, 1 not comparable"
 has "compare: new and vanished counted" "$md" "2 new; 2 vanished"
 row "$md" "bunny | 69451 | 2048 | 2" > "$TMP/row"
