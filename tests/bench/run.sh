@@ -61,6 +61,8 @@ rm "$TMP/old/failures.txt"
 expect "save: finished run kept" 0 "8 figures" -- "$ROOT/bench/run.sh" --save-baseline "$TMP/old" "$base"
 has "save: key and figure rows" "$base" 'raster_threads.csv,scene=bunny res=2048 threads=2,speedup,r+,1.800,2,aaaaaaa11111,"Test CPU, 2 cores",0.30,'
 cp "$base" "$TMP/kept.csv"
+expect "save: again" 0 "8 figures" -- "$ROOT/bench/run.sh" --save-baseline "$TMP/old" "$base"
+cmp -s "$base" "$TMP/kept.csv" && ok "save: the old baseline replaced whole" || no "save: the old baseline replaced whole" "differs"
 touch "$TMP/empty/complete.txt"
 expect "save: no figures refused" 1 "no figures" -- "$ROOT/bench/run.sh" --save-baseline "$TMP/empty" "$base"
 cmp -s "$base" "$TMP/kept.csv" && ok "save: baseline unchanged when refused" || no "save: baseline unchanged when refused" "changed"
