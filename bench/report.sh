@@ -138,6 +138,10 @@ table() {
             m = split(cols, want, " ")
             split(marks, part, "[|]"); nk = split(part[1], keys, " "); nf = split(part[2], figs, " ")
             for (j = 1; j <= nf; j++) {
+                if (figs[j] !~ /.:[rac][-+]$/) {
+                    printf "report: marks %s: \"%s\": expected NAME:KD, K one of r, a, c and D + or -\n", tname, figs[j] > "/dev/stderr"
+                    exit 2
+                }
                 c = figs[j]; sub(/:[rac][-+]$/, "", c)
                 for (k = 1; k <= m && want[k] != c; k++) ;
                 if (k > m) want[++m] = c
