@@ -52,7 +52,8 @@ function is_number(s) { return s ~ /^[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?
 # BASE_HEADER's columns; "key" joins the key columns as NAME=VALUE.
 BASE_HEADER="table,key,figure,kind,value,threads,commit,cpu_model,load_1min,date"
 
-# marks CSV: "KEYS | FIGURES" for the rows of CSV. KEYS are the columns that
+# MARKS: one line per CSV, "CSV KEYS | FIGURES"; marks CSV gives the rest of
+# CSV's line. KEYS are the columns that
 # identify a measurement (scene, technique, size, threads, settings...; a key
 # that comes again in the same CSV, as growth.csv's map_size when it is also
 # a technique's main parameter, is told apart by its order: "#2"). FIGURES
@@ -64,27 +65,27 @@ BASE_HEADER="table,key,figure,kind,value,threads,commit,cpu_model,load_1min,date
 #      loaded, else "n/c", not comparable; loaded: a 1-minute load above
 #      the row's threads + 1),
 #   c  a machine-independent count (margin 0: any change is real).
-# A CSV not listed here is shown as it is and named in the summary.
-marks() {
-    case $1 in
-    reference_throughput.csv)   echo "scene samples threads | reference_rays_per_s:a+ ratio:r+" ;;
-    single_sample_overhead.csv) echo "scene radius threads | shadow_ratio:r- ray_tracer_ratio:r-" ;;
-    llvmpipe_depth.csv)         echo "scene res threads | shadowlab_ms:a- speedup:r+ vs_fill:r- coverage_mismatch:c-" ;;
-    llvmpipe_pcf.csv)           echo "scene width height map_res K threads | shadowlab_ms:a- speedup:r+ samples_off:c-" ;;
-    growth.csv)                 echo "technique axis value scene light settings threads | frame_ms:a-" ;;
-    constant_time.csv)          echo "technique settings prefilter light threads | frame_max_ms:a- ratio:r-" ;;
-    light_size.csv)             echo "technique map_size scene threads | frame_large_ms:a- ratio:r-" ;;
-    work.csv)                   echo "technique light settings | texel_fetches_per_sample:c- rays_per_sample:c- frame_bytes_built:c-" ;;
-    sweep_reuse.csv)            echo "sweep technique points threads | sweep_ms:a- ratio:r- builds:c-" ;;
-    reference_scaling.csv)      echo "scene rays threads | reference_ms_n:a- reference_speedup:r+ ratio:r+" ;;
-    raster_threads.csv)         echo "scene res threads | ms_n:a- speedup:r+" ;;
-    threads_eval.csv)           echo "technique threads light settings width height | ms_n:a- speedup:r+" ;;
-    memory.csv)                 echo "technique map_res light | peak_rss_mib:a- ratio:r-" ;;
-    startup.csv)                echo "command | first_line_ms:a- exit_ms:a-" ;;
-    silhouette.csv)             echo "segments threads | ns_per_triangle:a- ns_per_triangle_over_smallest:r-" ;;
-    volumes.csv)                echo "scene versus map_size threads | shadow_volume_ms:a- ratio:r-" ;;
-    esac
-}
+# A CSV not listed here is shown as it is and named in the summary; a CSV
+# shown twice is compared in the first of its tables.
+MARKS='
+reference_throughput.csv    scene samples threads | reference_rays_per_s:a+ ratio:r+
+single_sample_overhead.csv  scene radius threads | shadow_ratio:r- ray_tracer_ratio:r-
+llvmpipe_depth.csv          scene res threads | shadowlab_ms:a- speedup:r+ vs_fill:r- coverage_mismatch:c-
+llvmpipe_pcf.csv            scene width height map_res K threads | shadowlab_ms:a- speedup:r+ samples_off:c-
+growth.csv                  technique axis value scene light settings threads | frame_ms:a-
+constant_time.csv           technique settings prefilter light threads | frame_max_ms:a- ratio:r-
+light_size.csv              technique map_size scene threads | frame_large_ms:a- ratio:r-
+work.csv                    technique light settings | texel_fetches_per_sample:c- rays_per_sample:c- frame_bytes_built:c-
+sweep_reuse.csv             sweep technique points threads | sweep_ms:a- ratio:r- builds:c-
+reference_scaling.csv       scene rays threads | reference_ms_n:a- reference_speedup:r+ ratio:r+
+raster_threads.csv          scene res threads | ms_n:a- speedup:r+
+threads_eval.csv            technique threads light settings width height | ms_n:a- speedup:r+
+memory.csv                  technique map_res light | peak_rss_mib:a- ratio:r-
+startup.csv                 command | first_line_ms:a- exit_ms:a-
+silhouette.csv              segments threads | ns_per_triangle:a- ns_per_triangle_over_smallest:r-
+volumes.csv                 scene versus map_size threads | shadow_volume_ms:a- ratio:r-
+'
+marks() { printf '%s\n' "$MARKS" | awk -v t="$1" '$1 == t { sub(/^[^ ]+ +/, ""); print; exit }'; }
 
 # table CSV COLUMNS...: a markdown table of the named columns of CSV, each
 # figure (marks) beside the baseline's for the same key: in report mode each
@@ -99,7 +100,11 @@ table() {
         [ "$mode" = save ] || { echo "(not run: $name missing)"; echo; }
         return 0
     fi
-    awk -v tname="$name" -v cols="$*" -v marks="$(marks "$name")" -v base="$base_in" -v has_base="$has_base" -v cmp="$cmp" -v save="$save" \
+    case " $compared " in
+    *" $name "*) spec='' again=1 ;;
+    *) spec=$(marks "$name") again=0 compared="$compared $name" ;;
+    esac
+    awk -v tname="$name" -v cols="$*" -v marks="$spec" -v again="$again" -v base="$base_in" -v has_base="$has_base" -v cmp="$cmp" -v save="$save" \
         -v noise_r="$noise_ratio" -v noise_a="$noise_absolute" "$CSV_AWK"'
         # A row is loaded when its 1-minute load exceeds its own thread count
         # by more than one: more than one other thread ran beside the bench.
@@ -147,8 +152,9 @@ table() {
                 if (k > m) want[++m] = c
                 role[k] = substr(figs[j], length(figs[j]) - 1)
             }
-            # A table with no figure is shown as it is, and named in the summary.
-            if (!nf && has_base) { printf "unmarked\t0\t%s\n", tname >> cmp; has_base = 0 }
+            # A table with no figure is shown as it is, and named in the summary
+            # unless its CSV was compared in an earlier table.
+            if (!nf && has_base && !again) { printf "unmarked\t0\t%s\n", tname >> cmp; has_base = 0 }
         }
         FILENAME == base {
             if (FNR == 1) { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
@@ -284,79 +290,6 @@ plot x with lines dashtype 2 title 'ideal'"
     fi
 }
 
-# The heading: the load during the run and the programs that failed.
-heading() {
-    echo "# shadowlab benchmarks"
-    echo
-    echo "Written by \`make bench\` (bench/run.sh, bench/report.sh); what each figure means and its target"
-    echo "are in bench/README.md. Load at the start and the end of the run:"
-    echo
-    sed 's/^/    /' "$dir/load.txt" 2>/dev/null || true
-    echo
-    if [ -s "$dir/failures.txt" ]; then
-        echo "**Programs that failed** (their tables below are missing or partial; the error is in the run's output):"
-        echo
-        sed 's/^/    /' "$dir/failures.txt"
-        echo
-    fi
-}
-
-# One section per bench: its tables (marks says which columns are keys and figures).
-sections() {
-    echo "## 1. Reference throughput against a bare Embree loop (target ratio >= 0.9)"
-    echo
-    echo "bare_rays_per_s is the fastest of rtcOccluded1, 4, 8, 16 and rtcOccluded1M (incoherent, coherent), named in fastest:"
-    echo
-    table reference_throughput.csv scene triangles samples rays fastest bare_rays_per_s reference_rays_per_s ratio occluded1_rays_per_s occluded16_rays_per_s threads load_1min commit
-    echo "Seed 002's overhead, single_sample_rt / hard:"
-    echo
-    table single_sample_overhead.csv scene radius shadow_ratio ray_tracer_ratio threads load_1min commit
-    echo "## 2. Against llvmpipe (target speed-up >= 2)"
-    echo
-    echo "![speed-up over llvmpipe](llvmpipe_depth.svg)"
-    echo
-    table llvmpipe_depth.csv scene triangles res llvmpipe_ms shadowlab_ms speedup fill_ms vs_fill coverage_mismatch depth_mismatch max_depth_diff agree threads load_1min commit
-    table llvmpipe_pcf.csv scene width height map_res K llvmpipe_ms shadowlab_ms speedup mae samples_off agree threads load_1min commit
-    echo "## 3. Cost growth"
-    echo
-    echo "Each technique on the scene named in its rows; where it does not handle the scene's light 1, the"
-    echo "light column names the light put in its place (bench_lab_open)."
-    echo
-    echo "![main parameter](growth_main.svg) ![map size](growth_map_size.svg)"
-    echo "![triangles](growth_triangles.svg) ![image size](growth_image_width.svg)"
-    echo
-    table growth.csv technique axis value frame_ms eval_ms build_ms resources_built note light threads load_1min
-    echo "Constant time in K with summed-area tables (target: largest K within 1.2x of the smallest):"
-    echo
-    table constant_time.csv technique settings prefilter K_min K_max frame_min_ms frame_max_ms ratio within light threads load_1min
-    echo "Constant in the light's size (the prefiltered PCSS family and occlusion textures claim it; pcss grows):"
-    echo
-    table light_size.csv technique map_size radius_small radius_large frame_small_ms frame_large_ms ratio within scene threads load_1min
-    echo "Machine-independent work per technique (core/counters.h), beside the hand count where one is known:"
-    echo
-    table work.csv technique texel_fetches_per_sample rays_per_sample frame_triangles frame_fragments frame_bytes_built hand_rule agrees light
-    echo "## 4. Sweep reuse (target <= 1.1; cached references not retraced)"
-    echo
-    table sweep_reuse.csv sweep technique points sweep_ms one_build_ms evals_ms ratio builds reuses within threads load_1min
-    echo "## 5. Thread scaling (target >= 1.8 at 2 threads; the reference >= 0.9 of bare Embree's own scaling)"
-    echo
-    echo "![thread speed-ups](threads_eval.svg)"
-    echo
-    table reference_scaling.csv scene rays threads bare_ms_1 bare_ms_n bare_speedup reference_ms_1 reference_ms_n reference_speedup ratio within load_1min
-    table raster_threads.csv scene triangles res threads ms_1 ms_n speedup load_1min
-    table threads_eval.csv technique threads ms_1 ms_n speedup light width height load_1min
-    echo "## 6. Peak memory, 4096^2 maps (target <= 1.2)"
-    echo
-    table memory.csv technique map_res peak_rss_mib resources_mib ratio within baseline_rss_mib note light load_1min
-    echo "## 7. Start-up (target: no OpenImageIO, first line under 20 ms)"
-    echo
-    table startup.csv command first_line_ms exit_ms loads_openimageio within load_1min
-    echo "## 8. Geometry (issue 14): silhouette extraction against triangles; shadow volumes against sm and hard"
-    echo
-    table silhouette.csv segments triangles silhouette_edges build_ms ns_per_triangle ns_per_triangle_over_smallest threads load_1min
-    table volumes.csv scene triangles versus map_size shadow_volume_ms other_ms ratio threads load_1min commit
-}
-
 # vanished: the baseline's figures this run has no row for (from $cmp, the
 # tables' comparisons), as markdown rows.
 vanished() {
@@ -426,13 +359,13 @@ summary() {
 }
 
 tab=$(printf '\t')
-save='' cmp=/dev/null base_in=/dev/null has_base=0
+save='' cmp=/dev/null base_in=/dev/null has_base=0 compared=
 if [ "$mode" = save ]; then
     [ -d "$(dirname "$baseline")" ] || { echo "report: $baseline: its folder does not exist" >&2; exit 2; }
     save="$baseline.tmp$$"
     trap 'rm -f "$save"' EXIT
     echo "$BASE_HEADER" > "$save"
-    sections > /dev/null
+    printf '%s\n' "$MARKS" | while read -r name rest; do [ -z "$name" ] || table "$name"; done
     figures=$(($(wc -l < "$save") - 1))
     [ "$figures" -gt 0 ] || { echo "report: $dir: no figures to keep as a baseline (no bench CSV there)" >&2; exit 1; }
     mv "$save" "$baseline"
@@ -445,11 +378,80 @@ if [ -f "$baseline" ]; then
     else base_problem="line 1 is not the header $BASE_HEADER"; echo "report: $baseline: $base_problem; nothing compared" >&2
     fi
 fi
-cmp="$dir/compare.tmp$$" body="$dir/body.tmp$$" gone="$dir/gone.tmp$$"
-trap 'rm -f "$cmp" "$body" "$gone" "$md.tmp$$"' EXIT
+cmp="$dir/compare.tmp$$" gone="$dir/gone.tmp$$" sum="$dir/summary.tmp$$"
+trap 'rm -f "$cmp" "$gone" "$sum" "$md.tmp$$"' EXIT
 : > "$cmp"
-sections > "$body"
-{ heading; summary; cat "$body"; } > "$md.tmp$$"
+
+{
+    echo "# shadowlab benchmarks"
+    echo
+    echo "Written by \`make bench\` (bench/run.sh, bench/report.sh); what each figure means and its target"
+    echo "are in bench/README.md. Load at the start and the end of the run:"
+    echo
+    sed 's/^/    /' "$dir/load.txt" 2>/dev/null || true
+    echo
+    if [ -s "$dir/failures.txt" ]; then
+        echo "**Programs that failed** (their tables below are missing or partial; the error is in the run's output):"
+        echo
+        sed 's/^/    /' "$dir/failures.txt"
+        echo
+    fi
+    echo "## 1. Reference throughput against a bare Embree loop (target ratio >= 0.9)"
+    echo
+    echo "bare_rays_per_s is the fastest of rtcOccluded1, 4, 8, 16 and rtcOccluded1M (incoherent, coherent), named in fastest:"
+    echo
+    table reference_throughput.csv scene triangles samples rays fastest bare_rays_per_s reference_rays_per_s ratio occluded1_rays_per_s occluded16_rays_per_s threads load_1min commit
+    echo "Seed 002's overhead, single_sample_rt / hard:"
+    echo
+    table single_sample_overhead.csv scene radius shadow_ratio ray_tracer_ratio threads load_1min commit
+    echo "## 2. Against llvmpipe (target speed-up >= 2)"
+    echo
+    echo "![speed-up over llvmpipe](llvmpipe_depth.svg)"
+    echo
+    table llvmpipe_depth.csv scene triangles res llvmpipe_ms shadowlab_ms speedup fill_ms vs_fill coverage_mismatch depth_mismatch max_depth_diff agree threads load_1min commit
+    table llvmpipe_pcf.csv scene width height map_res K llvmpipe_ms shadowlab_ms speedup mae samples_off agree threads load_1min commit
+    echo "## 3. Cost growth"
+    echo
+    echo "Each technique on the scene named in its rows; where it does not handle the scene's light 1, the"
+    echo "light column names the light put in its place (bench_lab_open)."
+    echo
+    echo "![main parameter](growth_main.svg) ![map size](growth_map_size.svg)"
+    echo "![triangles](growth_triangles.svg) ![image size](growth_image_width.svg)"
+    echo
+    table growth.csv technique axis value frame_ms eval_ms build_ms resources_built note light threads load_1min
+    echo "Constant time in K with summed-area tables (target: largest K within 1.2x of the smallest):"
+    echo
+    table constant_time.csv technique settings prefilter K_min K_max frame_min_ms frame_max_ms ratio within light threads load_1min
+    echo "Constant in the light's size (the prefiltered PCSS family and occlusion textures claim it; pcss grows):"
+    echo
+    table light_size.csv technique map_size radius_small radius_large frame_small_ms frame_large_ms ratio within scene threads load_1min
+    echo "Machine-independent work per technique (core/counters.h), beside the hand count where one is known:"
+    echo
+    table work.csv technique texel_fetches_per_sample rays_per_sample frame_triangles frame_fragments frame_bytes_built hand_rule agrees light
+    echo "## 4. Sweep reuse (target <= 1.1; cached references not retraced)"
+    echo
+    table sweep_reuse.csv sweep technique points sweep_ms one_build_ms evals_ms ratio builds reuses within threads load_1min
+    echo "## 5. Thread scaling (target >= 1.8 at 2 threads; the reference >= 0.9 of bare Embree's own scaling)"
+    echo
+    echo "![thread speed-ups](threads_eval.svg)"
+    echo
+    table reference_scaling.csv scene rays threads bare_ms_1 bare_ms_n bare_speedup reference_ms_1 reference_ms_n reference_speedup ratio within load_1min
+    table raster_threads.csv scene triangles res threads ms_1 ms_n speedup load_1min
+    table threads_eval.csv technique threads ms_1 ms_n speedup light width height load_1min
+    echo "## 6. Peak memory, 4096^2 maps (target <= 1.2)"
+    echo
+    table memory.csv technique map_res peak_rss_mib resources_mib ratio within baseline_rss_mib note light load_1min
+    echo "## 7. Start-up (target: no OpenImageIO, first line under 20 ms)"
+    echo
+    table startup.csv command first_line_ms exit_ms loads_openimageio within load_1min
+    echo "## 8. Geometry (issue 14): silhouette extraction against triangles; shadow volumes against sm and hard"
+    echo
+    table silhouette.csv segments triangles silhouette_edges build_ms ns_per_triangle ns_per_triangle_over_smallest threads load_1min
+    table volumes.csv scene triangles versus map_size shadow_volume_ms other_ms ratio threads load_1min commit
+} > "$md"
+# The summary goes above the first section, once every table has compared its figures.
+summary > "$sum"
+awk -v sum="$sum" '!done && /^## / { while ((getline l < sum) > 0) print l; done = 1 } { print }' "$md" > "$md.tmp$$"
 mv "$md.tmp$$" "$md"
 plots
 echo "report: $md"
