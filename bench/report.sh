@@ -154,7 +154,7 @@ table() {
             }
             # A table with no figure is shown as it is, and named in the summary
             # unless its CSV was compared in an earlier table.
-            if (!nf && has_base && !again) { printf "unmarked\t0\t%s\n", tname >> cmp; has_base = 0 }
+            if (!nf && has_base) { if (!again) printf "unmarked\t0\t%s\n", tname >> cmp; has_base = 0 }
         }
         FILENAME == base {
             if (FNR == 1) { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
