@@ -338,7 +338,7 @@ summary() {
             printf "0 for a machine-independent count (c). Absolute figures compare across runs only on the same cpu_model\n"
             printf "with neither run loaded (1-minute load above the row'"'"'s threads + 1); elsewhere they are n/c, and the\n"
             printf "tables'"'"' baseline column says why.\n\n"
-            if (unmarked != "") printf "Not compared (no line in marks() of bench/report.sh): %s.\n\n", unmarked
+            if (unmarked != "") printf "Not compared (no line in MARKS of bench/report.sh): %s.\n\n", unmarked
         }' "$cmp" "$baseline"
     if grep -q '^worse' "$cmp"; then
         echo "Worse, worst first:"
