@@ -39,7 +39,7 @@ PLUGIN  := $(B)/libshadowlab_oiio.so
 # The Lua module for a plain lua5.4: require "shadowlab" with package.cpath = "build/?.so;...".
 LUAMOD  := $(B)/shadowlab.so
 
-.PHONY: all deps test test-unit demo bench docs clean fuzz fuzzers FORCE
+.PHONY: all deps test test-unit demo bench bench-baseline docs clean fuzz fuzzers FORCE
 all: $(B)/shadowlab $(PLUGIN) $(LUAMOD)
 
 $(DEPS): scripts/deps.sh
@@ -127,6 +127,10 @@ docs: all
 
 bench: all
 	$(MAKE) -C bench
+
+# A finished `make bench`'s figures (reports/bench) kept as the baseline the next reports compare with.
+bench-baseline:
+	./bench/run.sh --save-baseline
 
 clean:
 	rm -rf $(B)

@@ -4,41 +4,208 @@
 # commit), the programs that failed (failures.txt), and gnuplot plots (SVG
 # and PNG, with their .gp scripts and .dat data): llvmpipe speed-ups against
 # map size, cost growth per axis, and the thread-scaling curves per technique
-# beside bare Embree's, each with its target or ideal drawn in.
-# Usage: bench/report.sh DIR
+# beside bare Embree's, each with its target or ideal drawn in. Every figure
+# stands beside the baseline's (bench/baseline/README.md), with a summary of
+# what got worse at the top.
+# Usage: bench/report.sh DIR [BASELINE]      DIR/README.md, against BASELINE
+#                                            (default bench/baseline/figures.csv)
+#        bench/report.sh --save DIR BASELINE DIR's figures as the baseline,
+#                                            BASELINE written whole or not at all
 set -eu
+mode=report
+if [ "${1:-}" = --save ]; then
+    [ $# -eq 3 ] || { echo "usage: $0 --save DIR BASELINE" >&2; exit 2; }
+    mode=save; shift
+fi
 dir=${1:-reports/bench}
+baseline=${2:-$(dirname "$0")/baseline/figures.csv}
 md="$dir/README.md"
+[ -d "$dir" ] || { echo "report: $dir: no such folder (the CSVs of a bench run)" >&2; exit 2; }
+# Noise margins, a fraction of the baseline's figure (bench/README.md).
+noise_ratio=${BENCH_NOISE_RATIO:-0.10}
+noise_absolute=${BENCH_NOISE_ABSOLUTE:-0.25}
+for v in "BENCH_NOISE_RATIO=$noise_ratio" "BENCH_NOISE_ABSOLUTE=$noise_absolute"; do
+    echo "${v#*=}" | grep -Eq '^(0|[1-9][0-9]*)?([.][0-9]+)?$' && [ -n "${v#*=}" ] ||
+        { echo "report: ${v%%=*} = '${v#*=}': expected a fraction of the baseline's figure, 0 or more (0.1 is 10%)" >&2; exit 2; }
+done
 
-# table CSV COLUMNS...: a markdown table of the named columns of CSV.
+# The CSV reading shared by every awk below: split_csv (RFC 4180 quotes,
+# doubled quotes inside them), csv_field (quotes a field that needs it),
+# is_number (a finite decimal: "nan", "inf" and empty cells are not figures).
+CSV_AWK='
+function split_csv(line, out,    n, i, c, q, field) {
+    n = 0; field = ""; q = 0
+    for (i = 1; i <= length(line); i++) {
+        c = substr(line, i, 1)
+        if (c == "\"") { if (q && substr(line, i + 1, 1) == "\"") { field = field c; i++ } else q = !q; continue }
+        if (c == "," && !q) { out[++n] = field; field = ""; continue }
+        field = field c
+    }
+    out[++n] = field
+    return n
+}
+function csv_field(s) { if (s !~ /[",]/) return s; gsub(/"/, "\"\"", s); return "\"" s "\"" }
+function is_number(s) { return s ~ /^[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?[0-9]+)?$/ }
+'
+
+# The baseline (bench/baseline/README.md): one row per figure of a stored run,
+# BASE_HEADER's columns; "key" joins the key columns as NAME=VALUE.
+BASE_HEADER="table,key,figure,kind,value,threads,commit,cpu_model,load_1min,date"
+
+# MARKS: one line per CSV, "CSV KEYS | FIGURES"; marks CSV gives the rest of
+# CSV's line. KEYS are the columns that
+# identify a measurement (scene, technique, size, threads, settings...; a key
+# that comes again in the same CSV, as growth.csv's map_size when it is also
+# a technique's main parameter, is told apart by its order: "#2"). FIGURES
+# are NAME:KD, a figure of kind K and direction D (+ higher is better,
+# - lower is better):
+#   r  a ratio measured within one run (noise margin 10%: BENCH_NOISE_RATIO),
+#   a  an absolute time, rate or size, compared across runs (margin 25%:
+#      BENCH_NOISE_ABSOLUTE; only on the same cpu_model with neither run
+#      loaded, else "n/c", not comparable; loaded: a 1-minute load above
+#      the row's threads + 1),
+#   c  a machine-independent count (margin 0: any change is real).
+# A CSV not listed here is shown as it is and named in the summary; a CSV
+# shown twice is compared in the first of its tables.
+MARKS='
+reference_throughput.csv    scene samples threads | reference_rays_per_s:a+ ratio:r+
+single_sample_overhead.csv  scene radius threads | shadow_ratio:r- ray_tracer_ratio:r-
+llvmpipe_depth.csv          scene res threads | shadowlab_ms:a- speedup:r+ vs_fill:r- coverage_mismatch:c-
+llvmpipe_pcf.csv            scene width height map_res K threads | shadowlab_ms:a- speedup:r+ samples_off:c-
+growth.csv                  technique axis value scene light settings threads | frame_ms:a-
+constant_time.csv           technique settings prefilter light threads | frame_max_ms:a- ratio:r-
+light_size.csv              technique map_size scene threads | frame_large_ms:a- ratio:r-
+work.csv                    technique light settings | texel_fetches_per_sample:c- rays_per_sample:c- frame_bytes_built:c-
+sweep_reuse.csv             sweep technique points threads | sweep_ms:a- ratio:r- builds:c-
+reference_scaling.csv       scene rays threads | reference_ms_n:a- reference_speedup:r+ ratio:r+
+raster_threads.csv          scene res threads | ms_n:a- speedup:r+
+threads_eval.csv            technique threads light settings width height | ms_n:a- speedup:r+
+memory.csv                  technique map_res light | peak_rss_mib:a- ratio:r-
+startup.csv                 command | first_line_ms:a- exit_ms:a-
+silhouette.csv              segments threads | ns_per_triangle:a- ns_per_triangle_over_smallest:r-
+volumes.csv                 scene versus map_size threads | shadow_volume_ms:a- ratio:r-
+'
+marks() { printf '%s\n' "$MARKS" | awk -v t="$1" '$1 == t { sub(/^[^ ]+ +/, ""); print; exit }'; }
+
+# table CSV COLUMNS...: a markdown table of the named columns of CSV, each
+# figure (marks) beside the baseline's for the same key: in report mode each
+# figure gets one more column, the baseline's value and new/old with its
+# mark, and the row a "baseline" column (the commit, "new" for a key the
+# baseline lacks, and why its absolute figures do not compare); every
+# comparison goes to $cmp for the summary. In save mode (report.sh --save)
+# each figure goes to $save as a baseline row instead.
 table() {
     f="$dir/$1"; name=$1; shift
-    [ -f "$f" ] || { echo "(not run: $name missing)"; echo; return; }
-    awk -F, -v cols="$*" '
-        function split_csv(line, out,    n, i, c, q, field) {
-            n = 0; field = ""; q = 0
-            for (i = 1; i <= length(line); i++) {
-                c = substr(line, i, 1)
-                if (c == "\"") { q = !q; continue }
-                if (c == "," && !q) { out[++n] = field; field = ""; continue }
-                field = field c
+    if [ ! -f "$f" ]; then
+        [ "$mode" = save ] || { echo "(not run: $name missing)"; echo; }
+        return 0
+    fi
+    case " $compared " in
+    *" $name "*) spec='' again=1 ;;
+    *) spec=$(marks "$name") again=0 compared="$compared $name" ;;
+    esac
+    awk -v tname="$name" -v cols="$*" -v marks="$spec" -v again="$again" -v base="$base_in" -v has_base="$has_base" -v cmp="$cmp" -v save="$save" \
+        -v noise_r="$noise_ratio" -v noise_a="$noise_absolute" "$CSV_AWK"'
+        # A row is loaded when its 1-minute load exceeds its own thread count
+        # by more than one: more than one other thread ran beside the bench.
+        function loaded(load, threads) { return is_number(load) && is_number(threads) && load + 0 > threads + 1 }
+        # Sets was, change and status for figure c (kind and direction kd) of
+        # the row with key `key`, and records the comparison in cmp. bad is
+        # old/new for a figure where higher is better, new/old otherwise
+        # (above 1: worse); a side at 0 has no ratio, only a direction.
+        function compare(key, c, kd, now, comparable,    old, new, bad, margin) {
+            bad = 0
+            if (!((key, c) in bval)) { was = "-"; change = "new"; status = "new" }
+            else if (!is_number(bval[key, c]) || !is_number(now) || bval[key, c] + 0 < 0 || now + 0 < 0) {
+                was = bval[key, c]; change = "n/a"; status = "n/a"    # empty, non-finite or negative
+            } else {
+                old = bval[key, c] + 0; was = bval[key, c]; new = now + 0
+                if (old == new) { bad = 1; change = "1.000" }
+                else if (old == 0 || new == 0) { bad = (new > old) == (substr(kd, 2, 1) == "-") ? 1e30 : 1e-30; change = new == 0 ? "to 0" : "from 0" }
+                else { bad = substr(kd, 2, 1) == "+" ? old / new : new / old; change = sprintf("%.3f", new / old) }
+                margin = substr(kd, 1, 1) == "r" ? noise_r : substr(kd, 1, 1) == "a" ? noise_a : 0
+                if (substr(kd, 1, 1) == "a" && !comparable) { status = "n/c"; change = change " (n/c)" }
+                else if (bad > 1 + margin) { status = "worse"; change = change " **worse**" }
+                else if (bad < 1 / (1 + margin)) { status = "better"; change = change " better" }
+                else status = "same"
             }
-            out[++n] = field
-            return n
+            printf "%s\t%g\t%s\t%s\t%s\t%s\t%s\t%s\n", status, bad, tname, key, c, was, now, change >> cmp
         }
-        NR == 1 {
-            n = split_csv($0, head); m = split(cols, want, " ")
-            for (k = 1; k <= m; k++) for (i = 1; i <= n; i++) if (head[i] == want[k]) idx[k] = i
+        # The baseline row of figure k of the current row (save mode).
+        function save_figure(key, k) {
+            print csv_field(tname) "," csv_field(key) "," want[k] "," role[k] "," csv_field(f[idx[k]]) "," \
+                  csv_field(f[col["threads"]]) "," csv_field(f[col["commit"]]) "," csv_field(f[col["cpu_model"]]) "," \
+                  csv_field(f[col["load_1min"]]) "," csv_field(f[col["date"]]) >> save
+        }
+        # want[1..m]: the columns shown; role[k] the kind and direction of a
+        # figure (a figure not shown is added at the end); keys[1..nk].
+        BEGIN {
+            m = split(cols, want, " ")
+            split(marks, part, "[|]"); nk = split(part[1], keys, " "); nf = split(part[2], figs, " ")
+            for (j = 1; j <= nf; j++) {
+                if (figs[j] !~ /.:[rac][-+]$/) {
+                    printf "report: marks %s: \"%s\": expected NAME:KD, K one of r, a, c and D + or -\n", tname, figs[j] > "/dev/stderr"
+                    exit 2
+                }
+                c = figs[j]; sub(/:[rac][-+]$/, "", c)
+                for (k = 1; k <= m && want[k] != c; k++) ;
+                if (k > m) want[++m] = c
+                role[k] = substr(figs[j], length(figs[j]) - 1)
+            }
+            # A table with no figure is shown as it is, and named in the summary
+            # unless its CSV was compared in an earlier table.
+            if (!nf && has_base) { if (!again) printf "unmarked\t0\t%s\n", tname >> cmp; has_base = 0 }
+        }
+        FILENAME == base {
+            if (FNR == 1) { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
+            split_csv($0, b)
+            if (b[bcol["table"]] != tname) next
+            key = b[bcol["key"]]
+            bval[key, b[bcol["figure"]]] = b[bcol["value"]]
+            bcommit[key] = b[bcol["commit"]]; bcpu[key] = b[bcol["cpu_model"]]
+            bload[key] = b[bcol["load_1min"]]; bthreads[key] = b[bcol["threads"]]
+            next
+        }
+        FNR == 1 {
+            n = split_csv($0, head)
+            for (i = 1; i <= n; i++) col[head[i]] = i
+            for (k = 1; k <= m; k++) idx[k] = col[want[k]]
+            for (k = 1; k <= m; k++) if (!idx[k]) printf "report: note: %s has no column %s\n", tname, want[k] > "/dev/stderr"
+            for (j = 1; j <= nk; j++) if (!col[keys[j]]) printf "report: note: %s has no key column %s\n", tname, keys[j] > "/dev/stderr"
+            if (save != "") next
             line = "|"; sep = "|"
-            for (k = 1; k <= m; k++) { line = line " " want[k] " |"; sep = sep "---|" }
+            for (k = 1; k <= m; k++) {
+                line = line " " want[k] " |"; sep = sep "---|"
+                if (has_base && (k in role)) { line = line " " want[k] " (baseline, new/old) |"; sep = sep "---|" }
+            }
+            if (has_base) { line = line " baseline |"; sep = sep "---|" }
             print line; print sep; next
         }
         {
-            split_csv($0, f); line = "|"
-            for (k = 1; k <= m; k++) line = line " " f[idx[k]] " |"
+            split_csv($0, f); key = ""
+            for (j = 1; j <= nk; j++) key = key (j > 1 ? " " : "") keys[j] "=" f[col[keys[j]]]
+            if (++repeat[key] > 1) key = key " #" repeat[key]
+            if (save != "") { for (k = 1; k <= m; k++) if (k in role) save_figure(key, k); next }
+            note = ""
+            if (has_base) {
+                if (!(key in bcommit)) note = "new"
+                else {
+                    note = substr(bcommit[key], 1, 7)
+                    if (bcpu[key] != f[col["cpu_model"]]) note = note ", other cpu_model (" bcpu[key] ")"
+                    if (loaded(bload[key], bthreads[key])) note = note ", baseline loaded (" bload[key] ")"
+                    if (loaded(f[col["load_1min"]], f[col["threads"]])) note = note ", loaded now (" f[col["load_1min"]] ")"
+                }
+            }
+            comparable = note !~ /other cpu_model|loaded/
+            line = "|"
+            for (k = 1; k <= m; k++) {
+                line = line " " f[idx[k]] " |"
+                if (has_base && (k in role)) { compare(key, want[k], role[k], f[idx[k]], comparable); line = line " " (status == "new" ? "new" : was ", " change) " |" }
+            }
+            if (has_base) line = line " " note " |"
             print line
-        }' "$f"
-    echo
+        }' "$base_in" "$f"
+    [ "$mode" = save ] || echo
 }
 
 # column CSV NAME...: the named columns, space-separated, for gnuplot.
@@ -123,6 +290,98 @@ plot x with lines dashtype 2 title 'ideal'"
     fi
 }
 
+# vanished: the baseline's figures this run has no row for (from $cmp, the
+# tables' comparisons), as markdown rows.
+vanished() {
+    awk -F'\t' -v base="$baseline" "$CSV_AWK"'
+        FILENAME != base { seen[$3, $4, $5] = 1; next }
+        FNR == 1 { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
+        {
+            split_csv($0, b)
+            if (!((b[bcol["table"]], b[bcol["key"]], b[bcol["figure"]]) in seen))
+                print "| " b[bcol["table"]] " | " b[bcol["key"]] " | " b[bcol["figure"]] " | " b[bcol["value"]] " |"
+        }' "$cmp" "$baseline"
+}
+
+# summary: the baseline's provenance, then how many figures got worse,
+# better, stayed within the noise, are new or vanished, and the worse ones
+# listed worst first, then the vanished ones.
+summary() {
+    echo "## Against the baseline"
+    echo
+    if [ "$has_base" = 0 ]; then
+        echo "No baseline ($baseline: $base_problem), so nothing is compared. \`make bench-baseline\` keeps a"
+        echo "finished run's figures as one (bench/baseline/README.md)."
+        echo
+        return
+    fi
+    vanished > "$gone"
+    awk -F'\t' -v base="$baseline" -v gone="$(wc -l < "$gone")" -v noise_r="$noise_ratio" -v noise_a="$noise_absolute" "$CSV_AWK"'
+        function range(lo, hi) { return lo == hi ? lo : lo " to " hi }
+        function add(list, item, sep) { return index(sep list sep, sep item sep) ? list : list (list == "" ? "" : sep) item }
+        FILENAME != base && $1 == "unmarked" { unmarked = add(unmarked, $3, ", "); next }
+        FILENAME != base { n[$1]++; total++; next }
+        FNR == 1 { nb = split_csv($0, bh); for (i = 1; i <= nb; i++) bcol[bh[i]] = i; next }
+        {
+            split_csv($0, b); rows++
+            commits = add(commits, substr(b[bcol["commit"]], 1, 7), ", "); cpus = add(cpus, b[bcol["cpu_model"]], "; ")
+            threads = add(threads, b[bcol["threads"]], ", ")
+            d = b[bcol["date"]]; if (dlo == "" || d < dlo) dlo = d; if (d > dhi) dhi = d
+            l = b[bcol["load_1min"]] + 0; if (rows == 1 || l < llo) llo = l; if (rows == 1 || l > lhi) lhi = l
+        }
+        END {
+            printf "Baseline `%s` (%d figures): commit %s; cpu_model %s; threads %s; %s; load_1min %s.\n\n", base, rows, commits, cpus, threads, range(dlo, dhi), range(llo, lhi)
+            printf "Of this run'"'"'s %d figures: **%d worse**, %d better, %d within the noise, %d not comparable", total, n["worse"], n["better"], n["same"], n["n/c"]
+            printf " (absolute, another cpu_model or a loaded run), %d without a number on one side, %d new; %d vanished", n["n/a"], n["new"], gone
+            printf " (in the baseline, not in this run).\n\n"
+            printf "Noise margins: %g%% for a ratio measured within one run (r), %g%% for an absolute time, rate or size (a),\n", noise_r * 100, noise_a * 100
+            printf "0 for a machine-independent count (c). Absolute figures compare across runs only on the same cpu_model\n"
+            printf "with neither run loaded (1-minute load above the row'"'"'s threads + 1); elsewhere they are n/c, and the\n"
+            printf "tables'"'"' baseline column says why.\n\n"
+            if (unmarked != "") printf "Not compared (no line in MARKS of bench/report.sh): %s.\n\n", unmarked
+        }' "$cmp" "$baseline"
+    if grep -q '^worse' "$cmp"; then
+        echo "Worse, worst first:"
+        echo
+        echo "| table | key | figure | baseline | now | new/old |"
+        echo "|---|---|---|---|---|---|"
+        grep '^worse' "$cmp" | sort -t "$tab" -k2,2gr | awk -F'\t' '{ print "| " $3 " | " $4 " | " $5 " | " $6 " | " $7 " | " $8 " |" }'
+        echo
+    fi
+    if [ -s "$gone" ]; then
+        echo "Vanished:"
+        echo
+        echo "| table | key | figure | baseline |"
+        echo "|---|---|---|---|"
+        cat "$gone"
+        echo
+    fi
+}
+
+tab=$(printf '\t')
+save='' cmp=/dev/null base_in=/dev/null has_base=0 compared=
+if [ "$mode" = save ]; then
+    [ -d "$(dirname "$baseline")" ] || { echo "report: $baseline: its folder does not exist" >&2; exit 2; }
+    save="$baseline.tmp$$"
+    trap 'rm -f "$save"' EXIT
+    echo "$BASE_HEADER" > "$save"
+    printf '%s\n' "$MARKS" | while read -r name rest; do [ -z "$name" ] || table "$name"; done
+    figures=$(($(wc -l < "$save") - 1))
+    [ "$figures" -gt 0 ] || { echo "report: $dir: no figures to keep as a baseline (no bench CSV there)" >&2; exit 1; }
+    mv "$save" "$baseline"
+    echo "report: baseline $baseline: $figures figures from $dir"
+    exit 0
+fi
+base_problem="absent"
+if [ -f "$baseline" ]; then
+    if [ "$(head -n 1 "$baseline")" = "$BASE_HEADER" ]; then has_base=1 base_in=$baseline
+    else base_problem="line 1 is not the header $BASE_HEADER"; echo "report: $baseline: $base_problem; nothing compared" >&2
+    fi
+fi
+cmp="$dir/compare.tmp$$" gone="$dir/gone.tmp$$" sum="$dir/summary.tmp$$"
+trap 'rm -f "$cmp" "$gone" "$sum" "$md.tmp$$"' EXIT
+: > "$cmp"
+
 {
     echo "# shadowlab benchmarks"
     echo
@@ -190,5 +449,9 @@ plot x with lines dashtype 2 title 'ideal'"
     table silhouette.csv segments triangles silhouette_edges build_ms ns_per_triangle ns_per_triangle_over_smallest threads load_1min
     table volumes.csv scene triangles versus map_size shadow_volume_ms other_ms ratio threads load_1min commit
 } > "$md"
+# The summary goes above the first section, once every table has compared its figures.
+summary > "$sum"
+awk -v sum="$sum" '!done && /^## / { while ((getline l < sum) > 0) print l; done = 1 } { print }' "$md" > "$md.tmp$$"
+mv "$md.tmp$$" "$md"
 plots
 echo "report: $md"

@@ -8,8 +8,22 @@
 # report); the others still run, and the script exits 1 at the end.
 # The bunny scenes need stanford-bunny.obj on SHADOWLAB_MODEL_PATH (default
 # ../shared/models) or glmark2-data's bunny.obj (scripts/deps.sh installs it).
+# A run that got to its end leaves complete.txt (its settings); --save-baseline
+# keeps such a run's figures, if no program failed, as the baseline the next
+# reports compare with (bench/baseline/README.md).
 # Usage: bench/run.sh BIN_DIR SAMPLES THREADS REPEAT
+#        bench/run.sh --save-baseline [DIR [BASELINE]]  (reports/bench, bench/baseline/figures.csv)
 set -u
+if [ "${1:-}" = --save-baseline ]; then
+    [ $# -le 3 ] || { echo "usage: $0 --save-baseline [DIR [BASELINE]]" >&2; exit 2; }
+    root=$(cd "$(dirname "$0")/.." && pwd)
+    dir=${2:-$root/reports/bench}
+    [ -f "$dir/complete.txt" ] ||
+        { echo "run.sh: $dir/complete.txt missing: not a finished run (make bench first); baseline unchanged" >&2; exit 1; }
+    [ ! -s "$dir/failures.txt" ] ||
+        { echo "run.sh: $dir/failures.txt: $(wc -l < "$dir/failures.txt") program(s) failed in that run; baseline unchanged" >&2; exit 1; }
+    exec "$root/bench/report.sh" --save "$dir" "${3:-$root/bench/baseline/figures.csv}"
+fi
 [ $# -eq 4 ] || { echo "usage: $0 BIN_DIR SAMPLES THREADS REPEAT" >&2; exit 2; }
 bin=$(cd "$1" && pwd) || exit 2
 samples=$2 threads=$3 repeat=$4
@@ -18,7 +32,7 @@ export SHADOWLAB_MODEL_PATH="${SHADOWLAB_MODEL_PATH:-$(pwd)/../shared/models}"
 out=reports/bench
 quick=${QUICK:-0}
 mkdir -p "$out" || exit 1
-rm -f "$out"/*.csv "$out"/*.dat "$out"/*.gp "$out"/*.svg "$out"/*.png "$out"/README.md "$out"/failures.txt
+rm -f "$out"/*.csv "$out"/*.dat "$out"/*.gp "$out"/*.svg "$out"/*.png "$out"/README.md "$out"/failures.txt "$out"/complete.txt
 uptime > "$out/load.txt"
 failures=0
 current=
@@ -82,7 +96,10 @@ run "$bin/geometry" --threads "$threads" --repeat "$repeat" -o "$out" scenes/bun
 
 uptime >> "$out/load.txt"
 current=report
+start=$(date +%s.%N)
 run ./bench/report.sh "$out"
+echo "run.sh: report written in $(echo "$(date +%s.%N) $start" | awk '{ printf "%.2f", $1 - $2 }') s"
+echo "samples=$samples threads=$threads repeat=$repeat quick=$quick finished=$(date -u +%Y-%m-%dT%H:%M:%SZ)" > "$out/complete.txt"
 if [ "$failures" -gt 0 ]; then
     echo >&2
     echo "run.sh: $failures program(s) FAILED; the other results are in $out:" >&2

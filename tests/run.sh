@@ -1,7 +1,8 @@
 #!/bin/bash
 # run.sh -- the whole suite: unit tests (built with ASan + UBSan), the
 # command-line tests (shadowlab_san: the CLI on the sanitized objects), the
-# Lua tests (optimised build), the stability suite (its harness and the
+# Lua tests (optimised build), the bench report's baseline comparison, the
+# stability suite (its harness and the
 # quick matrix optimised and, but for image_4096x4096, sanitized), the
 # fuzzers, valgrind and the atomic-output kill test. Prints each suite's
 # line and the total as "N passed, N failed"; exits non-zero on any failure.
@@ -57,6 +58,7 @@ suite() {
 suite san_run "./$B/test_unit_san"
 suite env SHADOWLAB_CACHE="$(mktemp -d)" ./tests/cli/run.sh "$B/shadowlab_san"
 suite ./tests/lua/run.sh "$B/shadowlab"
+suite ./tests/bench/run.sh # the bench report against its baseline: hand-made CSVs, no program run
 # The stability suite: its harness self-tests ("harness:") and the engine's
 # extreme cases under ASan + UBSan ("sanitized:"), the registry's whole
 # matrix in quick mode, two one-thread runs at once ("stability:"), then the
@@ -72,7 +74,7 @@ suite ./tests/stability/atomic.sh "$B/shadowlab"
 passed=$(sed -n 's/^[a-z]*: \([0-9]*\) passed, \([0-9]*\) failed$/\1/p' "$log" | awk '{s+=$1} END {print s+0}')
 failed=$(sed -n 's/^[a-z]*: \([0-9]*\) passed, \([0-9]*\) failed$/\2/p' "$log" | awk '{s+=$1} END {print s+0}')
 suites=$(grep -c '^[a-z]*: [0-9]* passed, [0-9]* failed$' "$log")
-[ "$suites" -eq 10 ] || failed=$((failed + 1)) # a suite that died before its summary
+[ "$suites" -eq 11 ] || failed=$((failed + 1)) # a suite that died before its summary
 failed=$((failed + bad_exits))
 echo "total: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
