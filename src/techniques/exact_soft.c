@@ -558,6 +558,7 @@ static int sum_edge(const ExactCasters *c, const LightPoints *lp, const Cone *co
     const int *side = entry + 2;
     for (int i = 0; i < ns; i++)
         if (side[2 * i + 1] < chunk && sc->reached[side[2 * i + 1]]) return size; /* summed there */
+    work_edges(1);
     if (!ball_in_cone(&c->edge_ball[entry[1]], &lp->f, cone)) return size;
     dvec3 a = {0}, b = {0};
     for (int i = 0; i < ns; i++) {
