@@ -223,7 +223,19 @@ static bool build_tree(BallTree *t, const Ball *ball, int n, double slack)
     for (int i = 0; i < n; i++) t->item[i] = i;
     TreeBuild b = {ball, t, slack};
     if (n > 0) build_node(&b, 0, n, 0);
+    BallNode *fit = realloc(t->node, sizeof *t->node * ((size_t)t->num_nodes + 1)); /* about n / 2 of the 2 n */
+    if (fit) t->node = fit;
     return true;
+}
+
+/* The trees' slack: 1e-9 of the casters' largest coordinate and the scene's
+ * extent, far above the cone and distance tests' rounding there. */
+static double tree_slack(const ExactCasters *c)
+{
+    double scale = c->extent;
+    for (size_t k = 0; k < 3 * (size_t)c->num_tris; k++)
+        scale = fmax(scale, fmax(fabs(c->tri[k].x), fmax(fabs(c->tri[k].y), fabs(c->tri[k].z))));
+    return 1e-9 * scale;
 }
 
 static void free_tree(BallTree *t)
@@ -266,13 +278,10 @@ static void free_edges(ExactEdges *e)
     free(e->side);
     free(e->edge_ball);
     free_tree(&e->edge_tree);
-    free_tree(&e->chunk_tree);
     free(e);
 }
 
-/* The welded edges, the possible silhouette ones listed, their tree and the
- * chunks' (the slack: 1e-9 of the casters' largest coordinate and extent,
- * far above the cone test's rounding there). */
+/* The welded edges, the possible silhouette ones listed and their tree. */
 static ExactEdges *build_edges(const ExactCasters *c)
 {
     size_t n = 3 * (size_t)c->num_tris;
@@ -281,13 +290,8 @@ static ExactEdges *build_edges(const ExactCasters *c)
     long welded = e && edge ? number_edges(c->tri, n, edge) : -1;
     bool ok = welded >= 0;
     if (ok) e->num_welded = (int)welded;
-    ok = ok && list_edges(c, edge, e);
+    ok = ok && list_edges(c, edge, e) && build_tree(&e->edge_tree, e->edge_ball, e->num_listed, tree_slack(c));
     free(edge);
-    double scale = c->extent;
-    for (size_t k = 0; k < n; k++) scale = fmax(scale, fmax(fabs(c->tri[k].x), fmax(fabs(c->tri[k].y), fabs(c->tri[k].z))));
-    double slack = 1e-9 * scale;
-    ok = ok && build_tree(&e->edge_tree, e->edge_ball, e->num_listed, slack) &&
-         build_tree(&e->chunk_tree, c->chunk_ball, c->num_chunks, slack);
     if (ok || !e) return e && ok ? e : NULL;
     free_edges(e);
     return NULL;
@@ -299,8 +303,7 @@ static size_t edges_bytes(const void *res)
     size_t sides = e->side_first ? (size_t)e->side_first[e->num_listed] : 0;
     return sizeof *e + ((size_t)e->num_listed + 1) * (sizeof *e->side_first + sizeof *e->edge_ball) +
            sides * sizeof *e->side +
-           (size_t)(e->edge_tree.num_nodes + e->chunk_tree.num_nodes) * sizeof(BallNode) +
-           ((size_t)e->num_listed + (size_t)e->chunk_tree.num_nodes) * sizeof(int);
+           (size_t)e->edge_tree.num_nodes * sizeof(BallNode) + (size_t)e->num_listed * sizeof(int);
 }
 
 static void edges_destroy(void *res) { free_edges(res); }
@@ -441,11 +444,13 @@ static bool collect_casters(const Scene *scene, const Silhouette *sil, const Bal
     for (int k = 0; k < c->num_chunks; k++)
         c->chunk_ball[k] = bound_corners(c->tri, 3 * c->chunk_first[k], 3 * c->chunk_first[k + 1]);
     for (int t = 0; t < c->num_tris; t++) plane_and_side(&c->tri[3 * t], light, &c->tri_normal[t], &c->tri_light_side[t]);
-    return true;
+    return build_tree(&c->chunk_tree, c->chunk_ball, c->num_chunks, tree_slack(c)) ||
+           error_set(err, "out of memory for %ld caster triangles", n);
 }
 
 void exact_casters_free(ExactCasters *c)
 {
+    free_tree(&c->chunk_tree);
     free(c->tri_chunk);
     free(c->tri_normal);
     free(c->tri_light_side);
@@ -512,25 +517,36 @@ static bool outside_closed(const ExactCasters *c, int o, const Frame *f)
     return c->object_closed[o] && d3_len(d3_sub(c->object_ball[o].centre, f->org)) > c->object_ball[o].radius;
 }
 
-/* Visits (fn) or finds (fn NULL) the triangles reaching the cone. */
-static bool visit_casters(const ExactCasters *c, const Frame *f, const Cone *cone, ExactTriangleFn fn,
-                          void *user)
+/* Calls fn for the triangles reaching the cone. */
+static void visit_casters(const ExactCasters *c, const Frame *f, const Cone *cone, ExactTriangleFn fn, void *user)
 {
-    bool any = false;
     for (int o = 0; o < c->num_objects; o++) {
         if (!exact_ball_in_cone(&c->object_ball[o], f, cone)) continue;
         bool front_only = outside_closed(c, o, f);
         for (int k = c->object_first[o]; k < c->object_first[o + 1]; k++) {
             if (!exact_ball_in_cone(&c->chunk_ball[k], f, cone)) continue;
-            for (int t = c->chunk_first[k]; t < c->chunk_first[k + 1]; t++) {
-                if (plane_separates(c, t, f)) continue;
-                if (!fn) return true;
-                any = true;
-                fn(user, &c->tri[3 * t], front_only);
-            }
+            for (int t = c->chunk_first[k]; t < c->chunk_first[k + 1]; t++)
+                if (!plane_separates(c, t, f)) fn(user, &c->tri[3 * t], front_only);
         }
     }
-    return any;
+}
+
+/* Does a triangle of chunk k reach the cone (visit_casters's tests)? */
+typedef struct ReachQuery {
+    const ExactCasters *c;
+    ExactConeQuery q;
+} ReachQuery;
+
+static bool chunk_has_reaching(void *user, int k)
+{
+    const ReachQuery *r = user;
+    const ExactCasters *c = r->c;
+    if (!exact_ball_in_cone(&c->chunk_ball[k], r->q.f, &r->q.cone) ||
+        !exact_ball_in_cone(&c->object_ball[c->chunk_object[k]], r->q.f, &r->q.cone))
+        return false;
+    for (int t = c->chunk_first[k]; t < c->chunk_first[k + 1]; t++)
+        if (!plane_separates(c, t, r->q.f)) return true; /* found: stop */
+    return false;
 }
 
 void exact_for_casters(const ExactCasters *c, const LightPoints *lp, ExactTriangleFn fn, void *user)
@@ -572,7 +588,8 @@ bool exact_begin(const ExactCasters *c, const TechContext *ctx, int s, LightPoin
     double dist = d3_len(d3_sub(lp->light.centre, f->org)), r = lp->light.radius;
     double cos_light = dist <= r ? -1.0 : sqrt(1.0 - (r / dist) * (r / dist)); /* every light point is inside */
     Cone cone = exact_cone(cos_light, EXACT_CONE_MARGIN);
-    return visit_casters(c, f, &cone, NULL, NULL);
+    ReachQuery reach = {c, {f, cone}};
+    return exact_tree_query(&c->chunk_tree, exact_cone_test, &reach.q, chunk_has_reaching, &reach);
 }
 
 void exact_draw(LightPoints *lp, const TechContext *ctx, int s)
@@ -719,8 +736,7 @@ bool exact_cone_test(const Ball *b, const void *query)
     return exact_ball_in_cone(b, q->f, &q->cone);
 }
 
-void exact_tree_query(const BallTree *t, BallTestFn in, const void *query, void (*fn)(void *user, int item),
-                      void *user)
+bool exact_tree_query(const BallTree *t, BallTestFn in, const void *query, BallItemFn fn, void *user)
 {
     int stack[EXACT_TREE_DEPTH + 1], top = 0;
     if (t->num_nodes > 0) stack[top++] = 0;
@@ -729,12 +745,14 @@ void exact_tree_query(const BallTree *t, BallTestFn in, const void *query, void 
         const BallNode *n = &t->node[id];
         if (!in(&n->ball, query)) continue;
         if (n->count > 0) {
-            for (int i = 0; i < n->count; i++) fn(user, t->item[n->first + i]);
+            for (int i = 0; i < n->count; i++)
+                if (fn(user, t->item[n->first + i])) return true;
             continue;
         }
         stack[top++] = n->first; /* the right child, after the left */
         stack[top++] = id + 1;
     }
+    return false;
 }
 
 /* One org's stage two (exact_for_silhouette). */
@@ -749,12 +767,12 @@ typedef struct SilhouetteVisit {
 } SilhouetteVisit;
 
 /* Listed edge e summed over its sides, if its sphere reaches the cone. */
-static void sum_edge(void *user, int e)
+static bool sum_edge(void *user, int e)
 {
     const SilhouetteVisit *v = user;
     const ExactEdges *edges = v->c->edges;
     work_edges(1);
-    if (!exact_ball_in_cone(&edges->edge_ball[e], &v->lp->f, &v->edge_cone.cone)) return;
+    if (!exact_ball_in_cone(&edges->edge_ball[e], &v->lp->f, &v->edge_cone.cone)) return false;
     dvec3 a = {0}, b = {0};
     int weight = 0;
     for (int i = edges->side_first[e]; i < edges->side_first[e + 1]; i++) {
@@ -770,6 +788,7 @@ static void sum_edge(void *user, int e)
         weight += exact_canonical(&a, &b) ? -w : w;
     }
     if (weight != 0) v->fn(v->user, a, b, weight);
+    return false;
 }
 
 /* Does triangle t cross the clip plane (corners on both sides)? */
@@ -792,11 +811,11 @@ static bool near_org(const Ball *b, const void *query)
  * EXACT_CLIP_EPS meets the widened cone (half-angle t < pi/2) within
  * EXACT_CLIP_EPS / cos t of org, so a clip edge farther away is outside it
  * (as an edge's sphere, above). */
-static void clip_plane_edges(void *user, int k)
+static bool clip_plane_edges(void *user, int k)
 {
     const SilhouetteVisit *v = user;
     const ExactCasters *c = v->c;
-    if (!near_org(&c->chunk_ball[k], v) || !chunk_reached(c, v->lp, v->sc, k)) return;
+    if (!near_org(&c->chunk_ball[k], v) || !chunk_reached(c, v->lp, v->sc, k)) return false;
     for (int t = c->chunk_first[k]; t < c->chunk_first[k + 1]; t++) {
         if (!crosses_clip_plane(&c->tri[3 * t], &v->lp->f)) continue;
         int w = triangle_weight(c, v->lp, v->sc, t);
@@ -806,6 +825,7 @@ static void clip_plane_edges(void *user, int k)
         for (int e = 0; e < np; e++)
             if (edge_of[e] < 0) v->fn(v->user, poly[e], poly[(e + 1) % np], w);
     }
+    return false;
 }
 
 bool exact_scratch_init(ExactScratch *sc, const ExactCasters *c)
@@ -837,5 +857,5 @@ void exact_for_silhouette(const ExactCasters *c, const LightPoints *lp, ExactScr
     SilhouetteVisit v = {c, lp, sc, {&lp->f, cone}, cone.cos_t > 0.0 ? 2.0 * EXACT_CLIP_EPS / cone.cos_t + 1e-12 : INFINITY,
                          fn, user};
     exact_tree_query(&c->edges->edge_tree, exact_cone_test, &v.edge_cone, sum_edge, &v);
-    exact_tree_query(&c->edges->chunk_tree, near_org, &v, clip_plane_edges, &v);
+    exact_tree_query(&c->chunk_tree, near_org, &v, clip_plane_edges, &v);
 }

@@ -70,15 +70,14 @@ typedef struct BallTree {
  * with its sides (3 t + k for each triangle t that traverses it from corner
  * k to k + 1, in triangle order) and its sphere, under a sphere hierarchy
  * (Laine et al. 2005 §4 bin them in a hemicube about the light; Lehtinen et
- * al. 2006's 3D tree is the hierarchy used here, see exact_soft.c); and the
- * casters' chunks under a second one, for the clip plane's edges near org. */
+ * al. 2006's 3D tree is the hierarchy used here, see exact_soft.c). */
 typedef struct ExactEdges {
     int num_welded;    /* every welded edge */
     int num_listed;    /* the possible silhouette edges */
     int *side_first;   /* per listed edge: its first side in side; num_listed + 1 */
     int *side;
     Ball *edge_ball;
-    BallTree edge_tree, chunk_tree;
+    BallTree edge_tree;
 } ExactEdges;
 
 /* Caster triangles in chunks of at most EXACT_CHUNK, each within one object. */
@@ -96,6 +95,7 @@ typedef struct ExactCasters {
     dvec3 *tri_normal;   /* per triangle: (t1 - t0) x (t2 - t0), world */
     int8_t *tri_light_side; /* per triangle: which side of its plane the light's ball lies on (exact_soft.c) */
     int *chunk_object;   /* per chunk: its object */
+    BallTree chunk_tree; /* over chunk_ball: exact_begin's cull, the clip plane's edges near org */
     const struct ExactEdges *edges; /* exact_for_silhouette's, a resource of the light; NULL unless asked for */
 } ExactCasters;
 
@@ -247,8 +247,9 @@ bool exact_ball_in_cone(const Ball *b, const Frame *f, const Cone *cone);
  * passes a node whenever it passes a sphere inside it): a superset of the
  * items whose own sphere passes. */
 typedef bool (*BallTestFn)(const Ball *b, const void *query);
-void exact_tree_query(const BallTree *t, BallTestFn in, const void *query, void (*fn)(void *user, int item),
-                      void *user);
+/* An item found; true stops the query, which then returns true. */
+typedef bool (*BallItemFn)(void *user, int item);
+bool exact_tree_query(const BallTree *t, BallTestFn in, const void *query, BallItemFn fn, void *user);
 /* The cone test as a BallTestFn: query is an ExactConeQuery. */
 typedef struct ExactConeQuery {
     const Frame *f;

@@ -175,11 +175,12 @@ typedef struct EdgeSet {
     long visited;
 } EdgeSet;
 
-static void mark_item(void *user, int e)
+static bool mark_item(void *user, int e)
 {
     EdgeSet *set = user;
     set->visited++;
     if (exact_ball_in_cone(&set->edges->edge_ball[e], &set->lp->f, &set->cone)) set->mark[e] = 1;
+    return false;
 }
 
 static void edge_sets_on(const char *scene)
