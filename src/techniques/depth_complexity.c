@@ -22,8 +22,12 @@
  * it. With edges=silhouette (exact_for_silhouette, Laine et al. 2005 §4's
  * two stages) only the light's possible silhouette edges that reach the
  * samples' cone are summed, and only those whose sum is not 0 run over the
- * light samples: the same counts as edges=all's every triangle (bunny,
- * 160x120, 256 samples: 4.4 s against 52.8 s). Crossing into a
+ * light samples: the same counts as edges=all's every triangle. Stage two
+ * descends a sphere tree over the listed edges (the `exact_edges` resource):
+ * bunny, 160x120, 256 samples, 35 edges tested per lit candidate where
+ * scanning the listed edges of the reached chunks tested 4,260; evaluation
+ * 2.03G instructions (callgrind) against the reference's 2.51G for the same
+ * rays, 14.67G before the tree. Crossing into a
  * front-facing triangle's projection raises D by 1. A
  * closed caster (silhouette.h) seen from outside its bounding sphere counts
  * its front faces only: D halves there, and is 0 where it was.

@@ -1,5 +1,20 @@
 /* exact_soft.c -- the exact soft-shadow techniques' shared light samples,
- * normalised light frame and caster culling (see exact_soft.h). */
+ * normalised light frame and caster culling (see exact_soft.h).
+ *
+ * Stage one's structure. Laine et al. 2005 §4 bin the possible silhouette
+ * edges' wedges in a hemicube about the light and look a point's cell up;
+ * a cell must hold every edge whose wedge reaches any point seen through it,
+ * and a wedge seen from the light spans the light's angular size at the edge
+ * (its half-angle about asin((r_light + r_edge) / distance)) however close
+ * behind the edge the point lies, where the cone from the point to the
+ * light meets only a sliver of the casters. Measured at 160x120 (per lit
+ * candidate, cells of no size, the best a hemicube can do): bunny 847 of
+ * its 13,854 listed edges against the 30.8 that reach the cone,
+ * sphere-on-plane 26.8 of 1,176 against 1.5. As
+ * Lehtinen et al. 2006 (course §5.3.2.3: a 3D kd-tree, "significantly less
+ * conservative" than the 2D grid), the edges' spheres go into a 3D
+ * hierarchy instead, descended per point with the very cone test stage two
+ * applies to each edge, so it returns exactly the edges that test passes. */
 #include "techniques/exact_soft.h"
 #include <math.h>
 #include <stdio.h>
