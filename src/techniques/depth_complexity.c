@@ -61,11 +61,11 @@ static const ParamDesc dc_params[] = {
      "which edges step the counters: silhouette (Laine et al. 2005 §4's two stages: the light's possible "
      "silhouette edges whose spheres reach the samples' cone, summed over their triangles from the view sample, "
      "the sums not 0 stepping) or all (every visited triangle's edges, the brute force): the same visibility bit "
-     "for bit; all is ~12x slower on the bunny at 160x120 and its near_edge also counts edges inside a surface",
+     "for bit; all is ~20x slower on the bunny at 160x120 and its near_edge also counts edges inside a surface",
      dc_edge_names},
 };
 
-static const char *const dc_resources[] = {"embree_bvh", "silhouette", NULL};
+static const char *const dc_resources[] = {"embree_bvh", "silhouette", "exact_edges", NULL};
 static const char *const dc_aux[] = {"near_edge", NULL};
 
 /* Laine's counters for one view sample. */
