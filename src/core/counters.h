@@ -23,6 +23,8 @@ typedef struct WorkCounters {
     uint64_t triangles;     /* triangles the rasterizer set up (before culling and clipping) */
     uint64_t fragments;     /* texels the rasterizer wrote (a fragment the depth test rejected is
                              * not counted: a lower bound of a GPU's fragment count under overdraw) */
+    uint64_t edges;         /* possible silhouette edges tested against a view sample's cone
+                             * (exact_soft.c's exact_for_silhouette: each edge sphere's cone test) */
 } WorkCounters;
 
 /* This thread's block; register-free to write (work_snapshot finds it).
@@ -53,6 +55,9 @@ static inline void work_raster(uint64_t triangles, uint64_t fragments)
     work_thread.c.triangles += triangles;
     work_thread.c.fragments += fragments;
 }
+
+/* n silhouette edges tested against a view sample's cone. */
+static inline void work_edges(uint64_t n) { work_thread.c.edges += n; }
 
 /* The sum over every thread that ever counted (threads that have exited
  * included). Call it from serial code, outside parallel regions: it runs one

@@ -202,6 +202,7 @@ static void write_counters(JsonWriter *w, const WorkCounters *c)
     json_int(w, "rays", (long long)c->rays);
     json_int(w, "triangles", (long long)c->triangles);
     json_int(w, "fragments", (long long)c->fragments);
+    json_int(w, "edges", (long long)c->edges);
 }
 
 /* Machine-independent work (core/counters.h): one evaluation's, the
@@ -225,6 +226,7 @@ static void write_work(JsonWriter *w, const RenderResult *r)
     json_number(w, "texel_fetches", (double)r->eval_work.texel_fetches / n);
     json_number(w, "texel_bytes", (double)r->eval_work.texel_bytes / n);
     json_number(w, "rays", (double)r->eval_work.rays / n);
+    json_number(w, "edges", (double)r->eval_work.edges / n);
     json_object_end(w);
     json_object_end(w);
 }

@@ -363,7 +363,7 @@ static int clip_axis(Q2 *poly, int n, int axis, double s, double lim)
     return m;
 }
 
-#define STAND_IN_GEN_MAX 20 /* its hull, a texel wider (+4) and clipped to the grid (+4): CAMERA_POLY_MAX */
+#define STAND_IN_GEN_MAX 24 /* its hull, a texel wider (+4) and clipped to the grid (+4): CAMERA_POLY_MAX */
 #define STAND_IN_NEARER 1e-4 /* the polygon's depth below the nearest point's, relative: past float's rounding of n / d */
 bool camera_count_stand_in(const CameraCount *cc, const Camera *cam, const double (*gen)[4], int num_gen, vec3 *poly,
                            int *n)

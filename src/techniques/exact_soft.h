@@ -47,6 +47,39 @@ typedef struct Ball {
     double radius;
 } Ball;
 
+/* A bounding-sphere hierarchy over items (edges, chunks): node 0 the root;
+ * an inner node's children are the next node and node `first`, a leaf's
+ * items item[first .. first + count). Each node's sphere holds its
+ * children's with a margin (exact_soft.c), so a cone or distance test that
+ * passes an item passes every node above it, in floating point too. */
+typedef struct BallNode {
+    Ball ball;
+    int first, count; /* count 0: inner */
+} BallNode;
+
+typedef struct BallTree {
+    int num_nodes;
+    BallNode *node;
+    int *item;
+} BallTree;
+#define EXACT_TREE_DEPTH 96 /* deepest node + 1 (exact_soft.c's build bounds it) */
+
+/* The possible silhouette edges of the light's ball (exact_for_silhouette,
+ * stage one): undirected edges of the welded casters (equal positions, -0 =
+ * +0, across objects) that can be a silhouette from some light point, each
+ * with its sides (3 t + k for each triangle t that traverses it from corner
+ * k to k + 1, in triangle order) and its sphere, under a sphere hierarchy
+ * (Laine et al. 2005 §4 bin them in a hemicube about the light; Lehtinen et
+ * al. 2006's 3D tree is the hierarchy used here, see exact_soft.c). */
+typedef struct ExactEdges {
+    int num_welded;    /* every welded edge */
+    int num_listed;    /* the possible silhouette edges */
+    int *side_first;   /* per listed edge: its first side in side; num_listed + 1 */
+    int *side;
+    Ball *edge_ball;
+    BallTree edge_tree;
+} ExactEdges;
+
 /* Caster triangles in chunks of at most EXACT_CHUNK, each within one object. */
 typedef struct ExactCasters {
     RTCScene rtc;      /* the casters' BVH: the techniques' one ray */
@@ -62,15 +95,8 @@ typedef struct ExactCasters {
     dvec3 *tri_normal;   /* per triangle: (t1 - t0) x (t2 - t0), world */
     int8_t *tri_light_side; /* per triangle: which side of its plane the light's ball lies on (exact_soft.c) */
     int *chunk_object;   /* per chunk: its object */
-    /* Possible silhouette edges of the light's ball (exact_for_silhouette):
-     * undirected edges of the welded casters (equal positions, -0 = +0,
-     * across objects), each an entry (its side count, then each side 3 t + k
-     * of a triangle t that traverses it from corner k to k + 1, and t's
-     * chunk) listed under each chunk of its triangles, with its sphere. */
-    int num_edges;       /* all welded edges */
-    long *chunk_edges;   /* per chunk: the offset of its entries in listing; num_chunks + 1 */
-    int *listing;
-    Ball *edge_ball;
+    BallTree chunk_tree; /* over chunk_ball: exact_begin's cull, the clip plane's edges near org */
+    const struct ExactEdges *edges; /* exact_for_silhouette's, a resource of the light; NULL unless asked for */
 } ExactCasters;
 
 /* Checks the sample parameters, acquires the casters' BVH and their
@@ -102,6 +128,12 @@ typedef struct Cone {
     double cos_t, sin_t;
 } Cone;
 #define EXACT_CONE_MARGIN 1e-9 /* radians the casters' culls widen a cone by */
+/* The samples' cone widened by this many radians, for the edges' spheres
+ * (exact_for_silhouette): an edge outside it crosses no segment between two
+ * kept samples' projections (they lie in the cone, which is convex) and is
+ * farther than EXACT_AMBIGUOUS_TAN from every sample, so leaving it out
+ * changes neither the counts nor near_edge. */
+#define EXACT_EDGE_CONE_MARGIN 1e-4
 /* The cone of half-angle acos(cos_cone) + margin (at most pi). */
 Cone exact_cone(double cos_cone, double margin);
 
@@ -171,22 +203,22 @@ static inline bool exact_canonical(dvec3 *a, dvec3 *b)
 /* The edges that step a depth-complexity count from org (Laine et al.
  * 2005 §4, "Soft shadow volumes for ray tracing": the silhouette edges from
  * the point to be shaded that overlap the light, found in two stages). Stage
- * one, once per light (exact_casters_init): the possible silhouette edges of
- * the light's bounding ball, every edge except a consistently oriented edge
- * of two triangles that both have the whole ball strictly on one side and
- * the same side (then from no light point is it a silhouette), each with
- * its bounding sphere, listed under the chunks of their triangles (where the
- * paper bins them in a hemicube about the light, the chunks' and the edges'
- * spheres are culled against the cone from org to the light, which is the
- * wedge test seen from org: an edge's wedge holds org iff the edge meets
- * that cone). Stage two, per org: the listed edges of the chunks that reach
- * the cone whose spheres reach it too (widened by EDGE_CONE_MARGIN, so
- * neither the counts nor near_edge lose anything), each summed over its
- * triangles as exact_for_casters visits them
- * (culling, facing from org, front_only, the clip to d.c >= EXACT_CLIP_EPS
- * from the inside corner, canonical order), and fn called with the sum where
- * it is not 0; also fn for each visited clipped triangle's edge along the
- * clip plane (its own). An edge left out in stage one never crosses a
+ * one, once per light (the `exact_edges` resource, ExactEdges): the possible
+ * silhouette edges of the light's bounding ball, every edge except a
+ * consistently oriented edge of two triangles that both have the whole ball
+ * strictly on one side and the same side (then from no light point is it a
+ * silhouette), each with its bounding sphere, under a sphere hierarchy. An
+ * edge's wedge holds org iff the edge meets the cone from org to the light,
+ * so stage two, per org, descends the hierarchy with that cone (the samples'
+ * cone widened by EXACT_EDGE_CONE_MARGIN, so neither the counts nor near_edge lose
+ * anything) and tests the spheres of the edges it reaches (work.edges counts
+ * them); each edge whose sphere reaches the cone is summed over its
+ * triangles as exact_for_casters visits them (culling, facing from org,
+ * front_only, the clip to d.c >= EXACT_CLIP_EPS from the inside corner,
+ * canonical order), and fn called with the sum where it is not 0; also fn
+ * for each visited clipped triangle's edge along the clip plane (its own),
+ * for the chunks the second hierarchy finds near org. An edge left out in
+ * stage one never crosses a
  * segment between two light samples' projections: from org it is no
  * silhouette (both triangles culled, or cancelling), or one of its planes
  * has org and the light strictly on one side, so no line from org through
@@ -195,16 +227,34 @@ static inline bool exact_canonical(dvec3 *a, dvec3 *b)
  * visiting every triangle's edges, bit for bit (tests/unit/test_exact_soft.c). */
 typedef void (*ExactEdgeFn)(void *user, dvec3 a, dvec3 b, int weight);
 
-/* One thread's scratch for exact_for_silhouette: 5 bytes per caster triangle. */
+/* One thread's scratch for exact_for_silhouette: 9 bytes per caster
+ * triangle. Each entry holds for the org whose stamp it carries. */
 typedef struct ExactScratch {
-    uint8_t *reached; /* per chunk: it reaches the cone; per object: 0 no, 1 yes, 2 yes and front faces suffice */
-    uint32_t org;     /* the current org's stamp */
-    uint32_t *stamp;  /* per triangle: the org its weight was found for */
-    int8_t *weight;   /* per triangle: its weight from that org */
+    uint32_t org;            /* the current org's stamp */
+    uint32_t *chunk_stamp;   /* per chunk, then per object */
+    uint8_t *reached;        /* per chunk: it reaches the cone; per object: 0 no, 1 yes, 2 yes and front faces suffice */
+    uint32_t *stamp;         /* per triangle: the org its weight was found for */
+    int8_t *weight;          /* per triangle: its weight from that org */
 } ExactScratch;
 
 bool exact_scratch_init(ExactScratch *sc, const ExactCasters *c);
 void exact_scratch_free(ExactScratch *sc);
 void exact_for_silhouette(const ExactCasters *c, const LightPoints *lp, ExactScratch *sc, ExactEdgeFn fn, void *user);
+
+/* Does ball b meet the cone about f->c of half-angle cone from f->org? */
+bool exact_ball_in_cone(const Ball *b, const Frame *f, const Cone *cone);
+/* Calls fn with each item of t whose node path passes `in` (a test that
+ * passes a node whenever it passes a sphere inside it): a superset of the
+ * items whose own sphere passes. */
+typedef bool (*BallTestFn)(const Ball *b, const void *query);
+/* An item found; true stops the query, which then returns true. */
+typedef bool (*BallItemFn)(void *user, int item);
+bool exact_tree_query(const BallTree *t, BallTestFn in, const void *query, BallItemFn fn, void *user);
+/* The cone test as a BallTestFn: query is an ExactConeQuery. */
+typedef struct ExactConeQuery {
+    const Frame *f;
+    Cone cone;
+} ExactConeQuery;
+bool exact_cone_test(const Ball *b, const void *query);
 
 #endif

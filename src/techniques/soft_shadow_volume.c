@@ -48,8 +48,12 @@
  * per-sample lists (camera_count_lists), and each sample sums the terms of
  * its listed edges, in edge order, after the same per-sample bounding cone
  * (edge_may_meet) as an all-edges loop, so the sum is the all-edges loop's
- * bit for bit. A wedge reaching the camera's near plane has no bounded
- * projection and is evaluated at every sample. Measured at 160x120 on the
+ * bit for bit. A wedge reaching the camera's near plane is cut by the plane
+ * at NEAR_CUT times the near distance first (cut_at_near), so only the
+ * samples its cut part covers get it; the few samples nearer than that
+ * plane sum every edge; a wedge whose cut part is unbounded along the plane
+ * (its directions on both sides of it) is still evaluated at every sample.
+ * Measured at 160x120 on the
  * bunny (test_soft_volumes, load 4, 2 threads): frame 0.30 s against 0.83 s
  * for the all-edges loop, evaluation 0.066 s against 0.72 s. */
 #include <math.h>
@@ -60,6 +64,7 @@
 #include "core/nanmath.h"
 #include "raster/camera_count.h"
 #include "resources/silhouette.h"
+#include "rt/view.h"
 #include "techniques/shadow_volume.h"
 #include "techniques/radial_area.h"
 #include "techniques/soft_shadow_volume.h"
@@ -92,8 +97,10 @@ typedef struct Patch {
     const Silhouette *sil;
     int32_t *count;     /* w(centre) per view sample */
     CameraLists wedges; /* per view sample, the edges whose wedge stand-in covers it */
-    int32_t *everywhere;/* edges whose wedge reaches the camera's near plane, ascending */
+    int32_t *everywhere;/* edges whose wedge has no bounded stand-in even cut at the near plane, ascending */
     int num_everywhere;
+    int num_cut;        /* wedges reaching the camera's near plane, cut there (cut_at_near) */
+    double near_depth;  /* samples nearer than this along the view axis sum every edge (0: none) */
     bool all_edges;     /* no lists: every edge at every sample (ssv_set_all_edges) */
 } Patch;
 
@@ -114,6 +121,8 @@ typedef struct SsvState {
 
 static bool all_edges_mode;
 void ssv_set_all_edges(bool on) { all_edges_mode = on; }
+static SsvNearStats near_stats;
+SsvNearStats ssv_near_stats(void) { return near_stats; }
 
 /* ---- 2D geometry in the light's plane (origin: the patch centre) ------------ */
 
@@ -262,9 +271,9 @@ typedef struct EdgeCursor {
     int all, next_all; /* all > 0: edges 0 .. all-1 */
 } EdgeCursor;
 
-static EdgeCursor edge_cursor(const Patch *pa, int s, bool all)
+static EdgeCursor edge_cursor(const Patch *pa, int s, float depth_view, bool all)
 {
-    if (all || pa->all_edges) return (EdgeCursor){.all = pa->sil->num_edges};
+    if (all || pa->all_edges || depth_view < pa->near_depth) return (EdgeCursor){.all = pa->sil->num_edges};
     const CameraLists *l = &pa->wedges;
     return (EdgeCursor){.list = l->item + l->start[s], .n_list = l->start[s + 1] - l->start[s],
                         .every = pa->everywhere, .n_every = pa->num_everywhere};
@@ -342,7 +351,7 @@ static double covered_fraction(const SsvState *st, const ViewSamples *vs, int s)
     for (int i = 0; i < st->num_patches; i++)
         if (k[i].area > 0.0)
             covered += patch_covered(st, &st->patch[i], st->patch[i].count[s], p, &f, &k[i],
-                                     edge_cursor(&st->patch[i], s, all)) /
+                                     edge_cursor(&st->patch[i], s, vs->depth_view[s], all)) /
                        (k[i].scale * k[i].scale);
     return covered / area; /* area > 0: light_shape refuses a light without one */
 }
@@ -435,8 +444,82 @@ static void light_shape(const TechContext *ctx, int per_side, SsvState *st)
     light_bound(st, per_side, ex, ey);
 }
 
+/* ---- wedges cut at the camera's near plane ---------------------------------------- */
+
+#define WEDGE_GEN_MAX (2 + 2 * 8) /* a wedge's generators: its 2 ends, each extruded from 8 corners */
+#define NEAR_CUT (1.0 + 1e-3)     /* the cut plane's depth over the near distance: camera_count_stand_in
+                                   * takes points past near (1 + 1e-6) / (1 - 1e-4) */
+
+
+/* The wedge conv(points) + cone(directions) (gen: points w = 1, directions
+ * w = 0, world) cut to the view depths d >= z_c: its generators at or past
+ * the plane, and the plane's points where a segment or ray between one
+ * past it and one before it crosses it, these replaced by their bounding
+ * rectangle in the plane (the cut polyhedron's vertices lie on its edges,
+ * each between two generators, and every such crossing lies in it, so the
+ * hull of the result holds the cut wedge). Returns the generators (0: the
+ * wedge lies before the plane), or -1 when the cut is unbounded along the
+ * plane: a direction along it, or directions on both sides. */
+static int cut_at_near(const double (*gen)[4], int m, const Camera *cam, dvec3 fwd, dvec3 right, dvec3 up,
+                       double (*out)[4])
+{
+    dvec3 eye = d3_from(cam->position);
+    double z_c = NEAR_CUT * cam->near_dist, l[WEDGE_GEN_MAX];
+    bool ahead = false, behind = false;
+    for (int i = 0; i < m; i++) {
+        dvec3 q = d3(gen[i][0], gen[i][1], gen[i][2]);
+        l[i] = gen[i][3] != 0.0 ? d3_dot(d3_sub(q, eye), fwd) - z_c : d3_dot(q, fwd);
+        if (gen[i][3] != 0.0) continue;
+        if (fabs(l[i]) <= 1e-9 * d3_len(q)) return -1;
+        ahead |= l[i] > 0.0;
+        behind |= l[i] < 0.0;
+    }
+    if (ahead && behind) return -1;
+    int n = 0;
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (int i = 0; i < m; i++) {
+        if (l[i] >= 0.0) memcpy(out[n++], gen[i], sizeof out[0]);
+        if (gen[i][3] == 0.0) continue;
+        dvec3 p = d3(gen[i][0], gen[i][1], gen[i][2]);
+        for (int j = 0; j < m; j++) { /* p's segment or ray toward j, crossing the plane */
+            if (j == i || (l[i] >= 0.0) == (l[j] >= 0.0) || (gen[j][3] != 0.0 && j < i)) continue;
+            dvec3 q = d3(gen[j][0], gen[j][1], gen[j][2]);
+            dvec3 x = gen[j][3] != 0.0 ? d3_madd(p, d3_sub(q, p), l[i] / (l[i] - l[j])) : d3_madd(p, q, -l[i] / l[j]);
+            double c[2] = {d3_dot(d3_sub(x, eye), right), d3_dot(d3_sub(x, eye), up)};
+            for (int k = 0; k < 2; k++) {
+                lo[k] = fmin(lo[k], c[k]);
+                hi[k] = fmax(hi[k], c[k]);
+            }
+        }
+    }
+    if (!(lo[0] <= hi[0])) return n;
+    for (int k = 0; k < 4; k++) {
+        dvec3 x = d3_madd(d3_madd(d3_madd(eye, fwd, z_c), right, k & 1 ? hi[0] : lo[0]), up, k & 2 ? hi[1] : lo[1]);
+        out[n][0] = x.x, out[n][1] = x.y, out[n][2] = x.z, out[n++][3] = 1.0;
+    }
+    return n;
+}
+
+/* Lit candidates that sum a wedge reaching the near plane, as pa's lists
+ * and rules give them (near_stats' `after`). */
+static long near_pairs(const TechContext *ctx, const Patch *pa, const bool *cut)
+{
+    long pairs = 0;
+    for (int s = 0; s < ctx->vs->count; s++) {
+        if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        if (ctx->vs->depth_view[s] < pa->near_depth) {
+            pairs += pa->num_cut + pa->num_everywhere;
+            continue;
+        }
+        pairs += pa->num_everywhere;
+        for (long i = pa->wedges.start[s]; i < pa->wedges.start[s + 1]; i++) pairs += cut[pa->wedges.item[i]];
+    }
+    return pairs;
+}
+
 /* Patch pa's wedge lists: each silhouette edge's stand-in drawn from the
- * camera, or the edge in `everywhere` when it has none. */
+ * camera (its wedge cut at the near plane where it reaches it), or the edge
+ * in `everywhere` when it has none. */
 static bool patch_wedges(const TechContext *ctx, const SsvState *st, CameraCount *cc, Patch *pa, Error *err)
 {
     int ne = pa->sil->num_edges;
@@ -448,6 +531,16 @@ static bool patch_wedges(const TechContext *ctx, const SsvState *st, CameraCount
         free(first);
         return error_set(err, "out of memory for %d wedges", ne);
     }
+    bool *cut = calloc((size_t)ne + 1, sizeof *cut);
+    if (!cut) {
+        free(verts);
+        free(first);
+        return error_set(err, "out of memory for %d wedges", ne);
+    }
+    const Camera *cam = &ctx->scene->camera;
+    vec3 f, r, u;
+    float tx, ty;
+    camera_axes(cam, ctx->vs->width, ctx->vs->height, &f, &r, &u, &tx, &ty);
     first[0] = 0;
     for (int i = 0; i < ne; i++) {
         dvec3 end[2] = {d3_from(pa->sil->edges[i].a), d3_from(pa->sil->edges[i].b)};
@@ -461,14 +554,31 @@ static bool patch_wedges(const TechContext *ctx, const SsvState *st, CameraCount
             }
         }
         int n = 0;
-        if (!camera_count_stand_in(cc, &ctx->scene->camera, (const double(*)[4])gen, m, verts + first[i], &n)) {
-            pa->everywhere[pa->num_everywhere++] = i;
+        if (!camera_count_stand_in(cc, cam, (const double(*)[4])gen, m, verts + first[i], &n)) {
+            double in[WEDGE_GEN_MAX + 4][4];
+            int mc = cut_at_near((const double(*)[4])gen, m, cam, d3_from(f), d3_from(r), d3_from(u), in);
             n = 0;
+            cut[i] = mc >= 0 && (mc == 0 || camera_count_stand_in(cc, cam, (const double(*)[4])in, mc, verts + first[i], &n));
+            if (cut[i]) pa->num_cut++;
+            else {
+                pa->everywhere[pa->num_everywhere++] = i;
+                n = 0;
+            }
         }
         first[i + 1] = first[i] + n;
     }
+    pa->near_depth = pa->num_cut > 0 ? NEAR_CUT * cam->near_dist * (1.0 + 1e-3) : 0.0;
     RasterStats fill;
     bool ok = camera_count_lists(cc, verts, first, ne, COUNT_NEARER, &pa->wedges, &fill, err);
+    if (ok) {
+        long lit = 0;
+        for (int s = 0; s < ctx->vs->count; s++) lit += ctx->cls[s] == SAMPLE_LIT_CANDIDATE;
+        near_stats.reaching += pa->num_cut + pa->num_everywhere;
+        near_stats.cut += pa->num_cut;
+        near_stats.before += lit * (pa->num_cut + pa->num_everywhere);
+        near_stats.after += near_pairs(ctx, pa, cut);
+    }
+    free(cut);
     free(verts);
     free(first);
     return ok;
@@ -544,6 +654,7 @@ static bool ssv_prepare_term(const TechContext *ctx, void **state, int term, Err
         return error_set(err, "%s: light %d has no area (radius, width or height 0)", name, ctx->light_index + 1);
     }
     CameraCount cc = {0};
+    if (!all_edges_mode) near_stats = (SsvNearStats){0};
     if (!all_edges_mode && !camera_count_init(&cc, &ctx->scene->camera, ctx->vs, ctx->vs->depth_view, err)) {
         free(st);
         return false;

@@ -8,4 +8,13 @@
 
 void ssv_set_all_edges(bool on);
 
+/* The last prepared run's (with lists) wedges reaching the camera's near plane (over its
+ * patches): how many, how many of them were cut there (the others go to
+ * every sample), and the (lit candidate, such wedge) pairs summed before
+ * the cut (every sample) and after it. */
+typedef struct SsvNearStats {
+    long reaching, cut, before, after;
+} SsvNearStats;
+SsvNearStats ssv_near_stats(void);
+
 #endif

@@ -11,6 +11,7 @@
 #include <string.h>
 #include "fixtures.h"
 #include "resources/standard.h"
+#include "techniques/exact_soft.h"
 #include "test.h"
 
 #define EXACT_SAMPLES 64
@@ -159,6 +160,80 @@ static void silhouette_sums_on(const char *scene)
     render_result_free(&all);
     render_result_free(&sil);
     lab_close(lab);
+}
+
+/* Stage two's sphere tree over the light's possible silhouette edges
+ * (exact_for_silhouette) against the brute force over every listed edge:
+ * per lit candidate, the tree's items whose own sphere reaches the widened
+ * samples' cone are, as a set, the listed edges whose sphere does, at 64x48
+ * with 64 samples. */
+typedef struct EdgeSet {
+    const ExactEdges *edges;
+    const LightPoints *lp;
+    Cone cone;
+    uint8_t *mark; /* per listed edge: 1 found by the tree */
+    long visited;
+} EdgeSet;
+
+static bool mark_item(void *user, int e)
+{
+    EdgeSet *set = user;
+    set->visited++;
+    if (exact_ball_in_cone(&set->edges->edge_ball[e], &set->lp->f, &set->cone)) set->mark[e] = 1;
+    return false;
+}
+
+static void edge_sets_on(const char *scene)
+{
+    Lab *lab = open_small(scene);
+    CHECK(lab);
+    Error err;
+    const Technique *t = tech_find("depth_complexity", &err);
+    double params[TECH_MAX_PARAMS];
+    CHECK(t);
+    tech_params_default(t, params);
+    CHECK(tech_param_parse(t, "samples=64", params, &err));
+    const Scene *sc = lab_scene(lab);
+    ResourceManager *rm = lab_resources(lab);
+    const ViewSamples *vs = res_view_samples(rm, sc, &err);
+    const uint8_t *cls = vs ? res_classes(rm, sc, 0, &err) : NULL;
+    CHECK(cls);
+    TechContext ctx = {sc, 0, &sc->lights[0], vs, cls, rm, params, 1, NULL};
+    ExactCasters cs;
+    CHECK(exact_casters_init(&ctx, true, &cs, &err));
+    LightPoints *lp = malloc(sizeof *lp);
+    EdgeSet set = {cs.edges, lp, {0, 0}, calloc((size_t)cs.edges->num_listed + 1, 1), 0};
+    CHECK(lp && set.mark);
+    long samples = 0, found = 0, differ = 0;
+    for (int s = 0; s < vs->width * vs->height; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE || !exact_begin(&cs, &ctx, s, lp)) continue;
+        exact_draw(lp, &ctx, s);
+        if (lp->kept == 0) continue;
+        samples++;
+        set.cone = exact_cone(lp->cos_cone, EXACT_EDGE_CONE_MARGIN);
+        memset(set.mark, 0, (size_t)cs.edges->num_listed);
+        ExactConeQuery q = {&lp->f, set.cone};
+        exact_tree_query(&cs.edges->edge_tree, exact_cone_test, &q, mark_item, &set);
+        for (int e = 0; e < cs.edges->num_listed; e++) {
+            bool in = exact_ball_in_cone(&cs.edges->edge_ball[e], &lp->f, &set.cone);
+            found += in;
+            differ += in != set.mark[e];
+        }
+    }
+    printf("    %s: %ld samples, %d listed edges of %d; %ld edges reach the cones, the tree visited %ld, %ld differ\n",
+           scene ? scene : "disk-box", samples, cs.edges->num_listed, cs.edges->num_welded, found, set.visited, differ);
+    CHECK(samples > 100 && found > samples);
+    CHECK(differ == 0);
+    free(set.mark);
+    free(lp);
+    exact_casters_free(&cs);
+    lab_close(lab);
+}
+
+TEST(test_exact_soft_silhouette_edge_tree_matches_every_listed_edge)
+{
+    edge_sets_on("sphere-on-plane.lua");
+    edge_sets_on("contact.lua");
 }
 
 TEST(test_exact_soft_depth_complexity_silhouette_sums_match_all_edges)

@@ -345,6 +345,32 @@ TEST(test_soft_volumes_wedge_lists_equal_all_edges)
     }
 }
 
+/* Wedges reaching the camera's near plane, cut there (cut_at_near) instead
+ * of summed at every sample: the lists' image is still the all-edges
+ * loop's bit for bit, and fewer (lit candidate, such wedge) pairs are
+ * summed. Sphere-on-plane at 160x120 with the camera under the ball inside
+ * its shadow volume (test_shadow_volume's camera_inside), and overlap.lua as
+ * it is (12 of its 16 edges reach the near plane). About 1.5 s. */
+TEST(test_soft_volumes_near_plane_wedges_cut)
+{
+    static const char *const one[] = {"patches=1", NULL};
+    static const char *const inside[] = {"camera.position={-0.27,0.28,-0.18}", "camera.target={2,0,2}", NULL};
+    static const char *const scenes[] = {"sphere-on-plane.lua", "overlap.lua"};
+    for (int i = 0; i < 2; i++) {
+        Lab *lab = soft_open(scenes[i], i == 0 ? inside : NULL);
+        CHECK(lab);
+        Lists l = lists_against_all_edges(lab, "soft_shadow_volume", one);
+        SsvNearStats st = ssv_near_stats(); /* the lists' run's: the all-edges run cuts nothing */
+        printf("    %s%s: %ld of %ld samples differ from all edges; %ld wedges reach the near plane, %ld cut there: "
+               "%ld (lit candidate, wedge) pairs summed, %ld before the cut\n",
+               scenes[i], i == 0 ? " (camera inside the ball's volume)" : "", l.differ, l.samples, st.reaching, st.cut,
+               st.after, st.before);
+        CHECK(l.differ == 0);
+        CHECK(st.reaching > 0 && st.cut > 0 && st.after < st.before);
+        lab_close(lab);
+    }
+}
+
 /* Casters that are not closed 2-manifolds under a sphere light (radius 0.5,
  * height 4) over the ground: a unit box at height 1 to 2 without its +x
  * face (4 open edges of 17: not a shell), a T of a square and a fin under
