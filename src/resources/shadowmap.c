@@ -183,13 +183,19 @@ static ShadowMap *map_alloc(const ShadowMapSpec *spec, uint64_t key, const Light
     return m;
 }
 
+/* Why a layer peeled behind a map of this spec cannot be drawn, or NULL. */
+static const char *peel_refusal(const ShadowMapSpec *s)
+{
+    if (s->projection >= MAP_PROJ_PSM && s->depth == RASTER_DEPTH_NDC)
+        return "a peeled layer of a warped map needs linear depth (its ndc depth is rescaled per texel)";
+    return NULL;
+}
+
 ShadowMap *shadowmap_render_behind(const Scene *scene, const ShadowMap *under, uint64_t key, Error *err)
 {
     MapProjection p = under->spec.projection;
     const char *why = p == MAP_PROJ_LOGPSM ? "a ray-cast map has no rasterized layer to peel behind"
-                      : p >= MAP_PROJ_PSM && under->spec.depth == RASTER_DEPTH_NDC
-                          ? "a peeled layer of a warped map needs linear depth (its ndc depth is rescaled per texel)"
-                          : NULL;
+                                           : peel_refusal(&under->spec);
     if (why) {
         error_set(err, "projection %s: %s", map_projection_name(p), why);
         return NULL;
@@ -367,8 +373,8 @@ const ShadowMap *res_shadow_map(ResourceManager *rm, const Scene *scene, int lig
         return NULL;
     }
     const char *why = spec->projection == MAP_PROJ_LOGPSM ? logmap_refusal(spec) : NULL;
-    if (spec->projection >= MAP_PROJ_PSM && spec->depth == RASTER_DEPTH_NDC && spec->layer == MAP_LAYER_PEELED)
-        why = "a peeled layer of a warped map needs linear depth (its ndc depth is rescaled per texel)";
+    const char *peel_why = spec->layer == MAP_LAYER_PEELED ? peel_refusal(spec) : NULL;
+    if (peel_why) why = peel_why;
     if (why) {
         error_set(err, "projection %s: %s", map_projection_name(spec->projection), why);
         return NULL;
