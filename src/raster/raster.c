@@ -384,6 +384,7 @@ typedef struct Target {
     int ti0, tj0;
     int32_t *id;      /* texel (i, j) at j * stride + i, as peel */
     const float *peel;
+    float peel_epsilon; /* RasterOptions.peel_epsilon */
     int stride;
     bool farthest, perspective, conservative;
     int32_t *count;         /* counting tests: counters and reference values at j * stride + i */
@@ -499,7 +500,7 @@ static long fill_span(const Fill *F, const Target *T, const SnapTri *t, int j, i
     for (int i = 0; i < n; i++) {
         float v = span_value((float)f_row, (float)fs, (float)q_row, (float)qs, (float)i, persp);
         if (T->conservative) v = v < F->fmin ? F->fmin : v > F->fmax ? F->fmax : v;
-        if (T->peel && !(v > T->peel[row + (size_t)i])) continue;
+        if (T->peel && !(v > T->peel[row + (size_t)i] + T->peel_epsilon)) continue;
         if (T->farthest ? !(v > d[i]) : !(v < d[i])) continue;
         d[i] = v;
         if (T->id) T->id[row + (size_t)i] = id;
@@ -599,7 +600,7 @@ static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, cons
     const RasterOptions *opt = s->opt;
     float local[TILE * TILE];
     bool counting = opt->test == RASTER_COUNT_LESS || opt->test == RASTER_COUNT_GREATER;
-    Target T = {local, ti0, tj0, db->triangle, opt->peel, s->width, opt->test == RASTER_FARTHEST,
+    Target T = {local, ti0, tj0, db->triangle, opt->peel, opt->peel_epsilon, s->width, opt->test == RASTER_FARTHEST,
                 s->mode == VALUE_PERSPECTIVE && opt->depth == RASTER_DEPTH_LINEAR, opt->conservative,
                 counting ? opt->count : NULL, opt->count_ref, opt->test == RASTER_COUNT_LESS, overflow};
     float empty = T.farthest ? -INFINITY : INFINITY;
@@ -746,6 +747,8 @@ static bool check_inputs(const RasterMesh *meshes, int num_meshes, const RasterV
     if (counting && (!opt->count || !opt->count_ref))
         return error_set(err, "raster: a counting test needs counters and reference values per texel");
     if (opt->triangle_ids && !db->triangle) return error_set(err, "raster: triangle ids asked for but not allocated");
+    if (!(opt->peel_epsilon >= 0.0f) || isinf(opt->peel_epsilon))
+        return error_set(err, "raster: peel_epsilon %g outside [0, inf)", (double)opt->peel_epsilon);
     if (opt->depth_bits != 0 && opt->depth_bits != 16 && opt->depth_bits != 24)
         return error_set(err, "raster: depth_bits %d is not one of 0 (float32), 16, 24", opt->depth_bits);
     if (view->mapping == RASTER_PARABOLOID && !(view->depth_far > view->depth_near))

@@ -79,8 +79,12 @@ typedef struct RasterOptions {
     bool conservative;    /* cover every texel the triangle touches (depth clamped to its range) */
     bool triangle_ids;    /* also store the winning triangle's index per texel */
     /* Depth peeling: when non-NULL (same size as the map), fragments at or in
-     * front of peel[texel] are discarded, so the map keeps the next layer. */
+     * front of peel[texel] + peel_epsilon are discarded (the test is strictly
+     * greater), so the map keeps the next layer behind it. peel_epsilon is in
+     * the map's value space (linear: world units along the light's axis;
+     * ndc: z_ndc) and >= 0; 0 peels behind the exact values. */
     const float *peel;
+    float peel_epsilon;
     /* Counting tests: the reference value per texel (same size and value
      * space as the map: linear depth or z_ndc), e.g. the view samples' own
      * depth. Fragments equal to it are not counted. */

@@ -32,7 +32,7 @@ size_t shadowmap_bytes_for(const Light *light, const ShadowMapSpec *spec)
     return texels * (sizeof(float) + (spec->triangle_ids ? sizeof(int32_t) : 0));
 }
 
-static void map_destroy(void *r)
+void shadowmap_free(void *r)
 {
     ShadowMap *m = r;
     free(m->depth);
@@ -40,14 +40,14 @@ static void map_destroy(void *r)
     free(m);
 }
 
-static size_t map_bytes(const void *r)
+size_t shadowmap_bytes(const void *r)
 {
     const ShadowMap *m = r;
     size_t texels = (size_t)m->num_faces * (size_t)m->res * (size_t)m->res;
     return sizeof *m + texels * (sizeof(float) + (m->triangle ? sizeof(int32_t) : 0));
 }
 
-static const ResourceKind kind_shadow_map = {"shadow_map", map_bytes, map_destroy, RES_FRAME};
+static const ResourceKind kind_shadow_map = {"shadow_map", shadowmap_bytes, shadowmap_free, RES_FRAME};
 
 typedef struct MapArgs {
     ResourceManager *rm;
@@ -110,22 +110,41 @@ static void base_ndc_depths(const LightView *lv, int face, float *depth)
     }
 }
 
-static bool render_faces(ShadowMap *m, const MapArgs *a, const ShadowMap *under, Error *err)
+/* The peel test's epsilon on one face (raster.h: fragments within it behind
+ * the layer peeled are discarded), in the map's value space: PEEL_EPSILON_REL
+ * of the face's depth range (linear: world units along the light's axis;
+ * ndc: of [0, 1]), plus one quantisation step on a quantised map, whose
+ * stored layer lies up to half a step in front of the surface it holds. */
+#define PEEL_EPSILON_REL 1e-5
+float shadowmap_peel_epsilon(const ShadowMap *m, int face)
 {
-    RasterMesh *meshes = malloc(sizeof *meshes * (size_t)(a->scene->num_objects > 0 ? a->scene->num_objects : 1));
+    const RasterView *v = &m->view.face[face].raster;
+    double range = m->spec.depth == RASTER_DEPTH_NDC ? 1.0 : v->depth_far - v->depth_near;
+    if (!(range > 0.0)) range = 0.0; /* a degenerate range: peel behind the exact values */
+    double step = m->spec.depth_bits ? range / (double)((1u << m->spec.depth_bits) - 1u) : 0.0;
+    return (float)(PEEL_EPSILON_REL * range + step);
+}
+
+/* Render m's faces from its view with its spec; under (a map of the same
+ * view, or NULL) is the layer peeled, by its exact depths (epsilon 0, the
+ * second layer of MAP_LAYER_PEELED) or with shadowmap_peel_epsilon. */
+static bool render_faces(ShadowMap *m, const Scene *sc, const ShadowMap *under, bool epsilon, Error *err)
+{
+    RasterMesh *meshes = malloc(sizeof *meshes * (size_t)(sc->num_objects > 0 ? sc->num_objects : 1));
     if (!meshes) return error_set(err, "out of memory");
-    int nm = caster_meshes(a->scene, meshes);
+    int nm = caster_meshes(sc, meshes);
     size_t face_texels = (size_t)m->res * (size_t)m->res;
     bool ok = true;
     RasterScratch *scratch = NULL; /* the faces' working memory, shared */
     for (int f = 0; ok && f < m->num_faces; f++) {
         DepthBuffer db = {m->res, m->res, m->depth + f * face_texels, m->triangle ? m->triangle + f * face_texels : NULL,
                           scratch};
-        RasterOptions opt = raster_options(&a->spec, under ? under->depth + f * face_texels : NULL);
+        RasterOptions opt = raster_options(&m->spec, under ? under->depth + f * face_texels : NULL);
+        if (under && epsilon) opt.peel_epsilon = shadowmap_peel_epsilon(under, f);
         RasterStats st;
         ok = raster_depth(meshes, nm, &m->view.face[f].raster, &opt, &db, &st, err);
         scratch = db.scratch;
-        if (ok && a->spec.depth == RASTER_DEPTH_NDC) base_ndc_depths(&m->view, f, db.depth);
+        if (ok && m->spec.depth == RASTER_DEPTH_NDC) base_ndc_depths(&m->view, f, db.depth);
         for (size_t i = 0; opt.test == RASTER_FARTHEST && i < face_texels; i++) /* the map's empty: +INFINITY */
             if (db.depth[i] == -INFINITY) db.depth[i] = INFINITY;
         m->stats.triangles_in += st.triangles_in;
@@ -137,6 +156,59 @@ static bool render_faces(ShadowMap *m, const MapArgs *a, const ShadowMap *under,
     raster_scratch_free(scratch);
     free(meshes);
     return ok;
+}
+
+/* A map of the spec from the view, its depth allocated (ids when the spec
+ * asks for them), nothing drawn yet. */
+static ShadowMap *map_alloc(const ShadowMapSpec *spec, uint64_t key, const LightView *view, Error *err)
+{
+    ShadowMap *m = calloc(1, sizeof *m);
+    if (!m) {
+        error_set(err, "out of memory");
+        return NULL;
+    }
+    m->spec = *spec;
+    m->key = key;
+    m->view = *view;
+    m->res = spec->res;
+    m->num_faces = m->view.num_faces;
+    size_t texels = (size_t)m->num_faces * (size_t)m->res * (size_t)m->res;
+    m->depth = malloc(texels * sizeof *m->depth);
+    if (spec->triangle_ids) m->triangle = malloc(texels * sizeof *m->triangle);
+    if (!m->depth || (spec->triangle_ids && !m->triangle)) {
+        error_set(err, "out of memory for a %d-face %d^2 shadow map", m->num_faces, m->res);
+        shadowmap_free(m);
+        return NULL;
+    }
+    return m;
+}
+
+/* Why a layer peeled behind a map of this spec cannot be drawn, or NULL. */
+static const char *peel_refusal(const ShadowMapSpec *s)
+{
+    if (s->projection >= MAP_PROJ_PSM && s->depth == RASTER_DEPTH_NDC)
+        return "a peeled layer of a warped map needs linear depth (its ndc depth is rescaled per texel)";
+    return NULL;
+}
+
+ShadowMap *shadowmap_render_behind(const Scene *scene, const ShadowMap *under, uint64_t key, Error *err)
+{
+    MapProjection p = under->spec.projection;
+    const char *why = p == MAP_PROJ_LOGPSM ? "a ray-cast map has no rasterized layer to peel behind"
+                                           : peel_refusal(&under->spec);
+    if (why) {
+        error_set(err, "projection %s: %s", map_projection_name(p), why);
+        return NULL;
+    }
+    ShadowMapSpec spec = under->spec;
+    spec.layer = MAP_LAYER_PEELED;
+    spec.triangle_ids = false;
+    ShadowMap *m = map_alloc(&spec, key, &under->view, err);
+    if (m && !render_faces(m, scene, under, true, err)) {
+        shadowmap_free(m);
+        return NULL;
+    }
+    return m;
 }
 
 /* ---- the light view: the map's fit, a frame resource of its own ---------- */
@@ -215,23 +287,10 @@ static void *build_map(const void *args, Error *err)
     if (cast && !casters) return NULL;
     const ShadowMap *under = a->spec.layer == MAP_LAYER_PEELED ? peel_source(a, err) : NULL;
     if (a->spec.layer == MAP_LAYER_PEELED && !under) return NULL;
-    ShadowMap *m = calloc(1, sizeof *m);
-    if (!m) { error_set(err, "out of memory"); return NULL; }
-    m->spec = a->spec;
-    m->key = a->key;
-    m->view = *view;
-    m->res = a->spec.res;
-    m->num_faces = m->view.num_faces;
-    size_t texels = (size_t)m->num_faces * (size_t)m->res * (size_t)m->res;
-    m->depth = malloc(texels * sizeof *m->depth);
-    if (a->spec.triangle_ids) m->triangle = malloc(texels * sizeof *m->triangle);
-    if (!m->depth || (a->spec.triangle_ids && !m->triangle)) {
-        error_set(err, "out of memory for a %d-face %d^2 shadow map", m->num_faces, m->res);
-        map_destroy(m);
-        return NULL;
-    }
-    if (!(cast ? logmap_cast(m, sc, casters, err) : render_faces(m, a, under, err))) {
-        map_destroy(m);
+    ShadowMap *m = map_alloc(&a->spec, a->key, view, err);
+    if (!m) return NULL;
+    if (!(cast ? logmap_cast(m, sc, casters, err) : render_faces(m, sc, under, false, err))) {
+        shadowmap_free(m);
         return NULL;
     }
     return m;
@@ -314,8 +373,8 @@ const ShadowMap *res_shadow_map(ResourceManager *rm, const Scene *scene, int lig
         return NULL;
     }
     const char *why = spec->projection == MAP_PROJ_LOGPSM ? logmap_refusal(spec) : NULL;
-    if (spec->projection >= MAP_PROJ_PSM && spec->depth == RASTER_DEPTH_NDC && spec->layer == MAP_LAYER_PEELED)
-        why = "a peeled layer of a warped map needs linear depth (its ndc depth is rescaled per texel)";
+    const char *peel_why = spec->layer == MAP_LAYER_PEELED ? peel_refusal(spec) : NULL;
+    if (peel_why) why = peel_why;
     if (why) {
         error_set(err, "projection %s: %s", map_projection_name(spec->projection), why);
         return NULL;

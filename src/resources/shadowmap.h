@@ -54,6 +54,19 @@ const ShadowMap *res_shadow_map(ResourceManager *rm, const Scene *scene, int lig
 /* Bytes a map of this spec would take (faces from the light and projection). */
 size_t shadowmap_bytes_for(const Light *light, const ShadowMapSpec *spec);
 
+/* Depth peeling (course §5.2.3.3's layers, Fig. 1.8): a map of under's view
+ * and spec holding, per texel, the nearest surface behind under's by more
+ * than shadowmap_peel_epsilon (the rasterizer's peel test, raster.h); empty
+ * (+INFINITY) where under is empty or nothing lies behind it. Its key is the
+ * caller's (resources/maps/peeled.c keys the layers of a map). Refused for
+ * ray-cast (logpsm) maps and warped ndc maps. */
+ShadowMap *shadowmap_render_behind(const Scene *scene, const ShadowMap *under, uint64_t key, Error *err);
+/* The peel test's epsilon on a face of m, in its stored value space. */
+float shadowmap_peel_epsilon(const ShadowMap *m, int face);
+/* A map's bytes, and its release (ResourceKind's bytes and destroy). */
+size_t shadowmap_bytes(const void *map);
+void shadowmap_free(void *map);
+
 /* Stored depth of texel (i, j) of a face, clamped to the edge: one texel
  * fetch of 4 bytes (counters.h). */
 static inline float shadowmap_texel(const ShadowMap *m, int face, int i, int j)

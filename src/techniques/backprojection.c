@@ -30,8 +30,13 @@
  *     same samples: over-occludes where polygons overlap); contour's loops
  *     take the bitmask by the crossing parity of their edges and the area
  *     exactly, by Green's theorem (radial_area.h).
- * Only casters seen from the light's centre exist (one layer; course
- * Fig. 1.8). The light is the scene's (sphere: its central cross-section).
+ * With layers = 1 only casters seen from the light's centre exist (course
+ * Fig. 1.8); layers = N adds the map's depth-peeled layers 1 .. N - 1
+ * (resources/maps/peeled.h: the k-th surface from the centre per texel),
+ * each layer's occluders built and projected as above and accumulated with
+ * the others' (bitmask: united, so a caster seen in two layers counts once;
+ * area: summed, over-occluding more). The light is the scene's (sphere:
+ * its central cross-section).
  *
  * The multiscale variants of course §5.2.3.4-5 run the same loop on other
  * min-max structures, which give the search area's bounds and the coarse
@@ -56,6 +61,7 @@
  * backprojected); `blend` mixes two budget levels. */
 #include <stdlib.h>
 #include "core/nanmath.h"
+#include "resources/maps/peeled.h"
 #include "techniques/backproject.h"
 #include "techniques/radial_area.h"
 
@@ -66,7 +72,9 @@ static const char *const gaps_names[] = {"none", "guennebaud", "diagonal", NULL}
 enum { ACC_BITMASK, ACC_AREA };
 static const char *const accumulate_names[] = {"bitmask", "area", NULL};
 
-enum { P_OCCLUDER = SMAP_NUM_PARAMS, P_GAPS, P_ACCUMULATE, P_TILES, P_BUDGET, P_EARLY_OUT, P_BLEND, P_HSM_LEVELS };
+enum {
+    P_OCCLUDER = SMAP_NUM_PARAMS, P_GAPS, P_ACCUMULATE, P_TILES, P_BUDGET, P_LAYERS, P_EARLY_OUT, P_BLEND, P_HSM_LEVELS
+};
 enum { EARLY_BOTH, EARLY_LIT, EARLY_NONE };
 static const char *const early_out_names[] = {"both", "lit", "none", NULL};
 enum { CLASS_LIT, CLASS_UMBRA, CLASS_BACKPROJECTED }; /* aux `class` */
@@ -104,6 +112,12 @@ enum { CLASS_LIT, CLASS_UMBRA, CLASS_BACKPROJECTED }; /* aux `class` */
      "texel budget T (course §5.2.3.5, Fig. 5.11): the search area is read at the finest level (min-pyramid "      \
      "nodes; in mssm and ysm MSSM windows above their base) whose window is at most T lexels a side (cost "        \
      "O(T^2) per receiver; aux `level`)",                                                                          \
+     NULL},                                                                                                        \
+    {"layers", PARAM_INT, 1, 1, PEELED_MAX_LAYERS, "layers",                                                       \
+     "depth-peeled layers from the light's centre (course §5.2.3.3, Fig. 1.8): occluders of every layer nearer "   \
+     "than the receiver are backprojected, each layer's polygons built on its own (bitmask: united; area: "        \
+     "summed, over-occluding more); 1: the map alone (the centre's first surfaces); layers past 1 are peeled "    \
+     "maps built by the rasterizer (resources/maps/peeled.h); search area and early outs read layer 0",            \
      NULL}
 
 /* The multiscale variants' own (course §5.2.3.4-5). */
@@ -148,6 +162,13 @@ typedef struct FaceSamples {
     double x0, y0, cell_x, cell_y; /* the grid's corner and cell size */
 } FaceSamples;
 
+/* One depth layer's min-depth structures (layer 0: the map's own): the
+ * pyramid, and the MSSM on its level `base` (mssm, ysm; NULL otherwise). */
+typedef struct BpLayer {
+    const MinMaxPyramid *pyramid;
+    const MinMaxLevels *mssm;
+} BpLayer;
+
 typedef struct BpState {
     SoftMap sm;
     SmapBias bias;
@@ -156,6 +177,8 @@ typedef struct BpState {
     bool blend, classify;     /* classify: aux `class` precedes `level` */
     const MinMaxLevels *mssm; /* NULL: the pyramid's aligned nodes only (backprojection, hsm) */
     int base;                 /* the pyramid level mssm is built on */
+    int layers;               /* depth-peeled layers backprojected, layer[0] the map's own */
+    BpLayer layer[PEELED_MAX_LAYERS];
     FaceSamples face[LIGHTVIEW_MAX_FACES];
 } BpState;
 
@@ -229,6 +252,23 @@ static bool mssm_base(Variant var, const double *p, int *base, Error *err)
                      *base + 1, pyramid_size(res, *base), res, MINMAX_LEVELS_MAX_RES, need, levels);
 }
 
+/* Layers 1 .. layers - 1, peeled behind the map (built only when layers > 1),
+ * each with the structures layer 0 has: its pyramid, and its MSSM where
+ * one is read. Only the budget's coarse lexels read them: the search area
+ * and the early outs read layer 0 (see visibility). */
+static bool acquire_layers(const TechContext *ctx, const ShadowMap *map, BpState *st, Error *err)
+{
+    st->layer[0] = (BpLayer){st->sm.pyramid, st->mssm};
+    for (int k = 1; k < st->layers; k++) {
+        const ShadowMap *peeled = res_peeled_layer(ctx->rm, ctx->scene, map, k, err);
+        BpLayer *L = &st->layer[k];
+        L->pyramid = peeled ? res_minmax_pyramid(ctx->rm, peeled, err) : NULL;
+        if (!L->pyramid) return false;
+        if (st->base >= 0 && !(L->mssm = res_minmax_levels(ctx->rm, L->pyramid, st->base, err))) return false;
+    }
+    return true;
+}
+
 static bool prepare_variant(const TechContext *ctx, Variant var, const char *tech, void **state, Error *err)
 {
     const double *p = ctx->params;
@@ -241,6 +281,8 @@ static bool prepare_variant(const TechContext *ctx, Variant var, const char *tec
     const ShadowMap *map = res_shadow_map(ctx->rm, ctx->scene, ctx->light_index, &spec, err);
     bool ok = map && softmap_init(&st->sm, ctx->rm, map, ctx->light, tech, err);
     if (ok && st->base >= 0) ok = (st->mssm = res_minmax_levels(ctx->rm, st->sm.pyramid, st->base, err)) != NULL;
+    st->layers = (int)p[P_LAYERS];
+    if (ok) ok = acquire_layers(ctx, map, st, err);
     if (!ok) {
         free(st);
         return false;
@@ -332,21 +374,21 @@ static Grid lexel_grid(const BpState *st, int level, int i, int j)
     return g;
 }
 
-/* The minimum stored depth of lexel (*i, *j) of the grid, and in *i, *j the
- * level-0 texel that holds it (seed 000's closest caster of a coarse
- * lexel, tested at that texel's own reference). */
-static float lexel_min(const BpState *st, int face, const Grid *g, int *i, int *j)
+/* The minimum stored depth of one layer over lexel (*i, *j) of the grid,
+ * and in *i, *j the level-0 texel that holds it (seed 000's closest caster
+ * of a coarse lexel, tested at that texel's own reference). */
+static float lexel_min(const BpState *st, const BpLayer *L, int face, const Grid *g, int *i, int *j)
 {
-    if (g->k < 0) return minmax_node_min(st->sm.pyramid, face, g->level, i, j);
+    if (g->k < 0) return minmax_node_min(L->pyramid, face, g->level, i, j);
     *i = g->oi + *i * (1 << g->k);
     *j = g->oj + *j * (1 << g->k);
-    float lo = minmax_levels_min(st->mssm, face, g->k, i, j); /* *i, *j: the base node */
-    minmax_node_min(st->sm.pyramid, face, st->base, i, j);    /* the same minimum, down to its texel */
+    float lo = minmax_levels_min(L->mssm, face, g->k, i, j); /* *i, *j: the base node */
+    minmax_node_min(L->pyramid, face, st->base, i, j);        /* the same minimum, down to its texel */
     return lo;
 }
 
-/* The occluder samples of one receiver: the search window at one budget
- * level, with a border of one lexel (gap filling and quads read their
+/* The occluder samples of one receiver in one layer: the search window at
+ * one budget level, with a border of one lexel (gap filling and quads read their
  * neighbours), each lexel's caster depth (world units), +INFINITY where
  * its closest texel does not lie in front of p, NaN where the test reads a
  * NaN (an unknown caster, issue 13 §1). */
@@ -376,7 +418,8 @@ static int budget_level(const BpState *st, int wi, int wj, double *t)
     return level;
 }
 
-static void load_window(const BpState *st, const SmapReceiver *r, int wi, int wj, int level, Window *w)
+static void load_window(const BpState *st, const BpLayer *L, const SmapReceiver *r, int wi, int wj, int level,
+                        Window *w)
 {
     const SoftFace *f = &st->sm.face[r->mc.face];
     int scale = 1 << level;
@@ -401,7 +444,7 @@ static void load_window(const BpState *st, const SmapReceiver *r, int wi, int wj
     for (int b = 0; b < w->h; b++)
         for (int a = 0; a < w->w; a++) {
             int ti = w->i0 + a, tj = w->j0 + b; /* off the face: edge-clamped, as every window of the map */
-            float stored = lexel_min(st, r->mc.face, &g, &ti, &tj); /* keeps NaN */
+            float stored = lexel_min(st, L, r->mc.face, &g, &ti, &tj); /* keeps NaN; empty: +INFINITY, lit */
             float lit = smap_test(smap_ref_at(r, ti, tj), stored);
             w->z[b][a] = lit == 0.0f ? smap_linear_depth(st->sm.map, r->mc.face, stored) : lit == 1.0f ? INFINITY : NAN;
         }
@@ -515,6 +558,14 @@ static double mask_share(const BpState *st, const uint64_t *mask)
     return (double)marked / st->samples; /* samples = 4 tiles^2 >= 4 */
 }
 
+/* What a receiver's occluders cover, over its polygons and layers. */
+typedef struct Occlusion {
+    uint64_t mask[BP_WORDS]; /* bitmask: the light samples covered, united */
+    long count;              /* area, polygons: samples covered, summed */
+    double share;            /* area, contour: exact shares of the light, summed */
+    bool unknown;            /* an occluder that may exist has an unknown place */
+} Occlusion;
+
 /* V = 1 - the covered share of the light, clamped to [0, 1]; NaN when an
  * occluder that may exist is unknown (issue 13 §1), unless the known ones
  * already cover the whole light (occluders only add: V = 0 either way). */
@@ -605,13 +656,14 @@ static P2 contour_vertex(const Window *w, int a, int b, const bool *in, const do
     return (P2){k[c] * (x - w->u), k[c] * (y - w->v)};
 }
 
-/* V of the window's contour loops: accumulate=area their exact covered
- * share of the light, bitmask the light samples they enclose. */
-static double contour_visibility(const BpState *st, const SoftLight *L, const FaceSamples *fs, const Window *w)
+/* The window's contour loops: accumulate=area their exact covered share of
+ * the light, added to o's; bitmask the light samples they enclose (the
+ * crossing parity of this layer's loops alone), united with o's. */
+static void contour_occlusion(const BpState *st, const SoftLight *L, const FaceSamples *fs, const Window *w,
+                              Occlusion *o)
 {
     uint64_t mask[BP_WORDS] = {0};
     double share = 0.0;
-    bool unknown = false;
     for (int b = 0; b < w->h - 1; b++)
         for (int a = 0; a < w->w - 1; a++) {
             bool in[4];
@@ -625,7 +677,7 @@ static double contour_visibility(const BpState *st, const SoftLight *L, const Fa
                 P2 p = contour_vertex(w, a, b, in, k, contour_table[code][e]);
                 P2 q = contour_vertex(w, a, b, in, k, contour_table[code][e + 1]);
                 if (isnan(p.x) || isnan(p.y) || isnan(q.x) || isnan(q.y)) {
-                    unknown = true;
+                    o->unknown = true;
                     continue;
                 }
                 if (st->accumulate == ACC_AREA)
@@ -634,34 +686,69 @@ static double contour_visibility(const BpState *st, const SoftLight *L, const Fa
                     toggle_crossings(fs, p, q, mask);
             }
         }
-    return share_visibility(st->accumulate == ACC_AREA ? share : mask_share(st, mask), unknown);
+    o->share += share;
+    for (int k = 0; k < BP_WORDS; k++) o->mask[k] |= mask[k];
 }
 
-/* 1 - occluded share of the light's samples over the window; NaN when an
- * occluder that may exist reads a NaN depth (issue 13 §1), unless the known
- * ones already cover every sample (occluders only add: V = 0 either way). */
-static double window_visibility(const BpState *st, const SoftFace *f, const FaceSamples *fs, const Window *w)
+/* Add the window's occluders to o: polygons' samples united (bitmask) or
+ * counted (area); an occluder that may exist but reads a NaN depth marks o
+ * unknown (issue 13 §1). */
+static void window_occlusion(const BpState *st, const SoftFace *f, const FaceSamples *fs, const Window *w,
+                             Occlusion *o)
 {
-    if (st->occluder == OCC_CONTOUR) return contour_visibility(st, &f->light, fs, w);
-    uint64_t mask[BP_WORDS] = {0};
-    long sum = 0;
-    bool patch = st->occluder == OCC_MICROPATCH, unknown = false;
+    if (st->occluder == OCC_CONTOUR) {
+        contour_occlusion(st, &f->light, fs, w, o);
+        return;
+    }
+    bool patch = st->occluder == OCC_MICROPATCH;
     for (int b = patch ? 1 : 0; b < w->h - 1; b++)
         for (int a = patch ? 1 : 0; a < w->w - 1; a++) {
             Poly p = {.n = 0};
             bool ok = patch ? win_z(w, a, b) != INFINITY && micropatch(st, w, a, b, &p) : microquad(st, w, a, b, &p);
             if (!ok) continue;
             if (poly_unknown(&p, patch)) {
-                unknown = true;
+                o->unknown = true;
                 continue;
             }
-            sum += cover(fs, &p, patch, st->accumulate == ACC_AREA ? NULL : mask); /* area: counted, not united */
+            o->count += cover(fs, &p, patch, st->accumulate == ACC_AREA ? NULL : o->mask); /* area: counted */
         }
-    if (st->accumulate == ACC_AREA) return share_visibility((double)sum / st->samples, unknown);
-    return share_visibility(mask_share(st, mask), unknown);
 }
 
-/* Visibility of one receiver; *cls its path (aux `class`), *level the budget level read. */
+/* 1 - the occluded share of the light's samples (area: the summed shares;
+ * contour's exact); NaN when an occluder that may exist is unknown, unless
+ * the known ones already cover every sample (occluders only add). */
+static double occlusion_visibility(const BpState *st, const Occlusion *o)
+{
+    if (st->accumulate == ACC_BITMASK) return share_visibility(mask_share(st, o->mask), o->unknown);
+    return share_visibility(st->occluder == OCC_CONTOUR ? o->share : (double)o->count / st->samples, o->unknown);
+}
+
+/* V over the search window at one budget level, occluders taken from every
+ * layer (course §5.2.3.3's depth-peeled layers): each layer's own lexels
+ * make its polygons (quads, gap filling and contours join neighbours of one
+ * layer), and a layer's lexel occludes where it passes the shadow test, i.e.
+ * lies nearer the light than the receiver; empty lexels (+INFINITY: a
+ * texel with fewer surfaces) never do. */
+static double level_visibility(const BpState *st, const SmapReceiver *r, int wi, int wj, int level, Window *w)
+{
+    const SoftFace *f = &st->sm.face[r->mc.face];
+    Occlusion o = {.unknown = false};
+    for (int k = 0; k < st->layers; k++) {
+        load_window(st, &st->layer[k], r, wi, wj, level, w);
+        window_occlusion(st, f, &st->face[r->mc.face], w, &o);
+    }
+    return occlusion_visibility(st, &o);
+}
+
+/* Visibility of one receiver; *cls its path (aux `class`), *level the budget
+ * level read. The search area and both early outs read layer 0 only, and
+ * stay exact with layers: per texel layer 0 is the nearest surface, so its
+ * z_min over an area is every layer's (no blocker of any layer lies nearer
+ * the light than z_b; lit where none can block); the umbra early out needs
+ * a height field in front of p over the whole area, and layer 0's, if it
+ * passes, is one (deeper layers only add occluders; their z_max would be
+ * wrong to use, an empty texel or a surface behind p failing an area that
+ * layer 0 already closes). */
 static float visibility(const BpState *st, const SmapReceiver *r, Window *w, int *cls, int *level)
 {
     double z_b, t;
@@ -675,13 +762,9 @@ static float visibility(const BpState *st, const SmapReceiver *r, Window *w, int
     if (st->early_out == EARLY_BOTH && area_occludes(st, r, wi, wj)) return 0.0f;
     *cls = CLASS_BACKPROJECTED;
     *level = budget_level(st, wi, wj, &t);
-    load_window(st, r, wi, wj, *level, w);
-    const SoftFace *f = &st->sm.face[r->mc.face];
-    double v = window_visibility(st, f, &st->face[r->mc.face], w);
-    if (st->blend && t > 0.0) { /* course §5.2.3.5: blending two levels hides the switch */
-        load_window(st, r, wi, wj, *level + 1, w);
-        v = (1.0 - t) * v + t * window_visibility(st, f, &st->face[r->mc.face], w);
-    }
+    double v = level_visibility(st, r, wi, wj, *level, w);
+    if (st->blend && t > 0.0) /* course §5.2.3.5: blending two levels hides the switch */
+        v = (1.0 - t) * v + t * level_visibility(st, r, wi, wj, *level + 1, w);
     return (float)v;
 }
 

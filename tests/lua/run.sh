@@ -281,7 +281,7 @@ run_repro() { # run_repro EXPERIMENT ARGS...: its output in $R/EXPERIMENT.log, i
     run_repro course-fig5.5-5.8-occluders --set camera.width=48 --set camera.height=36 --samples 16 --repeat 1 \
         --warmup 0 --no-images --quiet --threads 1 # ~2 s
     run_repro course-fig1.8-layers --scenes one-layer.lua,overlap.lua,sphere-on-plane.lua --map-size 256 \
-        --set camera.width=48 --set camera.height=36 --samples 16 --threads 1 # ~2 s
+        --set camera.width=48 --set camera.height=36 --samples 16 --threads 1 # ~8 s on a loaded machine
 ) &
 lane=$!
 run_repro seed000-fig3 $TINYQ
@@ -346,6 +346,10 @@ figure course_ch7_coarse_worse_than_pcss "$R/course-ch7-backprojection-vs-pcss/r
 figure course_fig1_8_hidden_layer "$R/course-fig1.8-layers/reproduction.csv" measured 3 8 \
     item~"one-layer: layers needed" --hold
 figure course_fig1_8_few_layers_cost "$R/course-fig1.8-layers/reproduction.csv" measured 1 10 item~"cap 2 / cap 16" --hold
+figure course_fig1_8_backprojection_layers "$R/course-fig1.8-layers/reproduction.csv" measured 2 8 \
+    item~"backprojection's layers that suffice" --hold
+figure course_fig1_8_backprojection_one_layer_leaks "$R/course-fig1.8-layers/reproduction.csv" measured 1 1000 \
+    item~"umbra leak, 1 layer / 4 layers" --hold
 figure fig3_7_lispsm_product "$R/fig3-7-aliasing-vs-z/reproduction.csv" measured 95 103 \
     item~LiSPSM quantity~"max e_x x" --hold
 figure fig3_13_no_warping_behind "$R/fig3-13-storage-factor/reproduction.csv" measured 0.9 1.1 item~"behind: W" --hold
