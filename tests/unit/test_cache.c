@@ -22,7 +22,7 @@ static bool fetch(const char *cache, Image *copy, RefInfo *info)
     Error err;
     Lab *lab = fixture_lab("cache.lua", scene_text);
     if (!lab) return false;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1}, cache};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1, false}, cache};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, info, &err);
     bool ok = ref && image_init(copy, ref->value.width, ref->value.height, ref->value.channels, &err);
     if (ok) memcpy(copy->data, ref->value.data, image_count(copy) * sizeof(float));

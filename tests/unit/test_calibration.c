@@ -40,7 +40,7 @@ static bool calibrate(Lab *lab, SamplingPattern pattern, int samples, Calibratio
     bool ok = sum && sq && se2;
     for (int k = 0; ok && k < SEEDS; k++) {
         RefInfo info;
-        RefRequest rq = {0, {MEASURE_VISIBILITY, samples, pattern, 1000u + (uint32_t)k}, NULL};
+        RefRequest rq = {0, {MEASURE_VISIBILITY, samples, pattern, 1000u + (uint32_t)k, false}, NULL};
         const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
         if (!ref) { printf("    reference: %s\n", err.msg); ok = false; break; }
         for (int s = 0; s < vs->count; s++) {
@@ -73,7 +73,7 @@ TEST(test_calibration_std_error_matches_the_spread_of_seeds)
 {
     Lab *lab = fixture_lab("penumbra.lua", penumbra_scene);
     CHECK(lab);
-    static const SamplingPattern patterns[] = {SAMPLING_RANDOM, SAMPLING_R2, SAMPLING_STRATIFIED};
+    static const SamplingPattern patterns[] = {SAMPLING_RANDOM, SAMPLING_R2, SAMPLING_STRATIFIED, false};
     static const int counts[] = {64, 256};
     int bad = 0;
     for (int p = 0; p < 3; p++)
@@ -103,7 +103,7 @@ TEST(test_calibration_delta_light_reports_one_exact_ray)
     CHECK(lab);
     Error err;
     RefInfo info;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, 256, SAMPLING_R2, 1}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, 256, SAMPLING_R2, 1, false}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     CHECK_MSG(ref, "%s", err.msg);
     double worst = 0;
@@ -166,7 +166,7 @@ TEST(test_calibration_cache_keeps_the_estimator)
         Lab *lab = fixture_lab("cached.lua", penumbra_scene);
         CHECK(lab);
         RefInfo info;
-        RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_STRATIFIED, 3}, cache};
+        RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_STRATIFIED, 3, false}, cache};
         const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
         CHECK_MSG(ref, "%s", err.msg);
         got[k] = (Reference){.rays_per_sample = ref->rays_per_sample, .estimator = ref->estimator,
