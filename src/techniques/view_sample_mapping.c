@@ -423,7 +423,8 @@ static void hough_bounds(const P2 *q, int np, double orientation, int bins, doub
     double delta = (M_PI / bins + 0x1p-22) * range + range / (bins - 1);
     P2 out[4]; /* per edge: its outward unit normal */
     for (int e = 0; e < np; e++) {
-        double dx = q[(e + 1) % np].x - q[e].x, dy = q[(e + 1) % np].y - q[e].y, len = hypot(dx, dy);
+        double dx = q[(e + 1) % np].x - q[e].x, dy = q[(e + 1) % np].y - q[e].y;
+        double len = sqrt(dx * dx + dy * dy); /* |q| < 1e100 (callers): no overflow, and cheaper than hypot */
         out[e] = (P2){dy / len * orientation, -dx / len * orientation}; /* right of a -> b when it turns left */
     }
     *lo = (P2){INFINITY, INFINITY};
@@ -437,8 +438,8 @@ static void hough_bounds(const P2 *q, int np, double orientation, int bins, doub
             return;
         }
         P2 c = {q[k].x + delta * (n1.x + n2.x) / cosine, q[k].y + delta * (n1.y + n2.y) / cosine};
-        *lo = (P2){fmin(lo->x, c.x), fmin(lo->y, c.y)};
-        *hi = (P2){fmax(hi->x, c.x), fmax(hi->y, c.y)};
+        *lo = (P2){c.x < lo->x ? c.x : lo->x, c.y < lo->y ? c.y : lo->y}; /* c is finite (cosine > 1e-12) */
+        *hi = (P2){c.x > hi->x ? c.x : hi->x, c.y > hi->y ? c.y : hi->y};
     }
 }
 
@@ -448,7 +449,7 @@ static void hough_bounds(const P2 *q, int np, double orientation, int bins, doub
  * sign of (C - org) . n_l), and widened by hough_bounds there (the same
  * lines, quantised in the same bins, |a_i| < range), misses the samples'
  * bounds: then no sample is inside every quantised line. A corner that
- * meets the plane behind org or never: no cull. */
+ * meets the plane behind org, never, or past 1e100: no cull. */
 static bool table_misses(const Mapped *m, const P2 *q, int np, const dvec3 axes[3])
 {
     const HoughTable *t = m->table;
@@ -462,6 +463,7 @@ static bool table_misses(const Mapped *m, const P2 *q, int np, const dvec3 axes[
         if (!(lambda > 0.0) || !isfinite(lambda)) return false;
         dvec3 hit = d3_sub(d3_scale(d, lambda), to_c); /* relative to the light's centre */
         pq[k] = (P2){d3_dot(hit, axes[1]), d3_dot(hit, axes[2])};
+        if (!(fabs(pq[k].x) < 1e100 && fabs(pq[k].y) < 1e100)) return false;
     }
     for (int k = 1; k + 1 < np; k++) area += exact_orient(pq[0], pq[k], pq[k + 1]);
     if (area == 0.0) return false;
