@@ -183,7 +183,7 @@ int sl_lab_open(lua_State *L)
 /* ---- options ------------------------------------------------------------ */
 
 static const char *const option_names[] = {"technique", "params", "light", "repeats", "warmup", "samples", "pattern",
-                                           "seed", "measure", "cache", "out", "png", "exr", "print",
+                                           "seed", "sample_set", "measure", "cache", "out", "png", "exr", "print",
                                            "time_budget", "error_scale", NULL};
 
 static void check_option_names(lua_State *L, int idx, const char *method)

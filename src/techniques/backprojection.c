@@ -737,7 +737,7 @@ static void bp_evaluate(const void *state, const TechContext *ctx, int begin, in
         int level = 0, cls = CLASS_LIT;
         if (w && smap_receiver(st->sm.map, &st->bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r))
             visibility(st, &r, w, &cls, &level, v);
-        else fill(v, ctx->channels, w ? 1.0f : NAN); /* outside the map: lit, as a lit early out; out of memory: no value */
+        else fill(v, ctx->channels, w ? 1.0f : NAN); /* outside the map: lit (a lit early out); no memory: no value */
         if (!ctx->aux) continue;
         if (st->classify) ctx->aux[(size_t)s * channels] = (float)cls;
         ctx->aux[(size_t)s * channels + channels - 1] = (float)level;

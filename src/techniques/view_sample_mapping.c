@@ -231,7 +231,11 @@ static size_t table_bytes_for(int bins, int n)
     return (size_t)bins * (size_t)n * sizeof(uint32_t) + (size_t)bins * (size_t)(n + 1) * (size_t)words * 8 +
            (size_t)bins * sizeof(float[2]);
 }
-static size_t table_bytes(const void *r) { return table_bytes_for(((const HoughTable *)r)->bins, ((const HoughTable *)r)->n); }
+static size_t table_bytes(const void *r)
+{
+    const HoughTable *t = r;
+    return table_bytes_for(t->bins, t->n);
+}
 static void table_destroy(void *r)
 {
     HoughTable *t = r;
@@ -377,7 +381,8 @@ static void light_plane_line(const Frame *f, P2 a, P2 b, double orientation, con
     dvec3 da = d3_add(d3_add(d3_scale(f->u, a.x), d3_scale(f->v, a.y)), f->c);
     dvec3 db = d3_add(d3_add(d3_scale(f->u, b.x), d3_scale(f->v, b.y)), f->c);
     dvec3 m = d3_scale(d3_cross(da, db), orientation);
-    double mx = d3_dot(m, axes[1]), my = d3_dot(m, axes[2]), len = hypot(mx, my), h = d3_dot(m, d3_sub(axes[0], f->org));
+    double mx = d3_dot(m, axes[1]), my = d3_dot(m, axes[2]), len = hypot(mx, my);
+    double h = d3_dot(m, d3_sub(axes[0], f->org));
     *nx = 1.0;
     *ny = 0.0;
     if (len > 0.0 && isfinite(h / len)) {
@@ -690,8 +695,8 @@ static bool vsm_prepare(const TechContext *ctx, void **state, Error *err)
     const HoughTable *table = NULL;
     bool hough = ctx->params[VSM_P_MASKS] == VSM_MASKS_HOUGH;
     if (hough && ctx->params[EXACT_P_SAMPLE_SET] == EXACT_SET_SHARED) {
-        if (!sampling_check_count((SamplingPattern)ctx->params[EXACT_P_PATTERN], (int)ctx->params[EXACT_P_SAMPLES], err) ||
-            !(table = acquire_table(ctx, err)))
+        SamplingPattern pattern = (SamplingPattern)ctx->params[EXACT_P_PATTERN];
+        if (!sampling_check_count(pattern, (int)ctx->params[EXACT_P_SAMPLES], err) || !(table = acquire_table(ctx, err)))
             return false;
     } else if (hough && !(normals = res_point_table(ctx->rm, "view_sample_mapping hough normals", hough_fill_normals,
                                                     (int)ctx->params[VSM_P_HOUGH_BINS], err)))

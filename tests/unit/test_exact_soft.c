@@ -297,14 +297,18 @@ static void rgb_on(const char *tech, float tolerance)
            "channel by more than %g (%ld of them with a light sample on a projected edge)\n",
            tech, candidates, coloured, differ, (double)tolerance, differ_near);
     CHECK(candidates > 1000 && coloured > 50);
-    CHECK_MSG(differ == differ_near, "%ld samples differ with no light sample near a projected edge", differ - differ_near);
+    CHECK_MSG(differ == differ_near, "%ld samples differ with no light sample near a projected edge",
+              differ - differ_near);
     CHECK(differ * 100 <= candidates);
     render_result_free(&r);
     lab_close(lab);
 }
 
 TEST(test_exact_soft_view_sample_mapping_matches_the_rgb_reference) { rgb_on("view_sample_mapping", 1e-6f); }
-TEST(test_exact_soft_depth_complexity_matches_the_rgb_reference) { rgb_on("depth_complexity", 1.0f / EXACT_SAMPLES * 1.001f); }
+TEST(test_exact_soft_depth_complexity_matches_the_rgb_reference)
+{
+    rgb_on("depth_complexity", 1.0f / EXACT_SAMPLES * 1.001f);
+}
 
 /* The stored table's refusals, by name: a sphere light (its samples are
  * directions from each view sample, not points of the light) and a table
