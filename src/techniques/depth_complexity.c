@@ -40,7 +40,9 @@
  * `near_edge` (aux) counts the light samples whose projection lies within
  * EXACT_AMBIGUOUS_TAN of a projected edge that steps the counts (a silhouette
  * edge from org, or a clipped triangle's edge on the clip plane), and those left out off the frame's axis: there the float ray test and the
- * projected predicate may disagree. */
+ * projected predicate may disagree. On a coloured (textured rect) light the
+ * lit samples, those of the least count, weigh by their colours
+ * (light_bitmask_visibility, the reference's ratio). */
 #include <math.h>
 #include <stdlib.h>
 #include "techniques/exact_soft.h"
