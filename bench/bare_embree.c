@@ -113,7 +113,7 @@ static bool parse_options(int argc, char **argv, Options *o)
 
 static ReferenceParams ref_params(const Options *o)
 {
-    return (ReferenceParams){MEASURE_VISIBILITY, o->samples, PATTERN, SEED};
+    return (ReferenceParams){MEASURE_VISIBILITY, o->samples, PATTERN, SEED, false};
 }
 
 static bool load_inputs(Lab *lab, const Options *o, Inputs *in, Error *err)

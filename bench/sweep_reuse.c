@@ -106,7 +106,7 @@ static bool radius_pass(const Options *o, const char *cache, int *hits, long lon
         Lab *lab = lab_open(o->scene, ovs, 3, err);
         if (!lab) return false;
         CompareRequest req = {.light_index = 0, .reference = true,
-                              .ref = {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1}, .cache_dir = cache};
+                              .ref = {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1, false}, .cache_dir = cache};
         CompareResult res;
         bool ok = lab_compare(lab, &req, &res, err);
         if (ok) {

@@ -417,7 +417,7 @@ static bool scaled_once(void *ctx, int side, int threads, double *seconds, Error
     const RtScene *bvh = res_bvh(rm, sc, RT_CASTERS, err);
     const ViewSamples *vs = bvh ? res_view_samples(rm, sc, err) : NULL;
     const uint8_t *cls = vs ? res_classes(rm, sc, 0, err) : NULL;
-    ReferenceParams prm = {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1};
+    ReferenceParams prm = {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1, false};
     Reference ref;
     double t0 = timer_now_s();
     bool ok = cls && reference_compute(bvh, sc, 0, vs, cls, &prm, &ref, err);

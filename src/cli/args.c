@@ -22,6 +22,9 @@ static const OptDesc opts[OPT_COUNT] = {
     [OPT_SAMPLES] = {"-n", "--samples", "N", "reference light samples per view sample (default 1024)"},
     [OPT_PATTERN] = {NULL, "--pattern", "P", "reference sampling: r2 | stratified | random (default r2)"},
     [OPT_SEED] = {NULL, "--seed", "S", "reference sampling seed (default 1)"},
+    [OPT_SAMPLE_SET] = {NULL, "--sample-set", "SET",
+                        "per_view_sample (each view sample its own stream; default) | shared (one light-sample set "
+                        "for the frame, view_sample_mapping's sample_set=shared)"},
     [OPT_MEASURE] = {NULL, "--measure", "M", "visibility | irradiance (Lambertian direct light; default visibility)"},
     [OPT_CACHE] = {NULL, "--cache", "DIR", "reference cache folder (default $SHADOWLAB_CACHE or ~/.cache/shadowlab)"},
     [OPT_NO_CACHE] = {NULL, "--no-cache", NULL, "neither read nor write the reference cache"},
@@ -104,6 +107,11 @@ static bool apply(CliOpt id, const char *a, const char *v, CliOptions *o, Error 
         if (!parse_int(a, v, 0, 2147483647, &seed, err)) return false;
         o->ref.seed = (uint32_t)seed;
         return true;
+    case OPT_SAMPLE_SET:
+        if (strcmp(v, "per_view_sample") != 0 && strcmp(v, "shared") != 0)
+            return error_set(err, "%s '%s' is not one of: per_view_sample, shared", a, v);
+        o->ref.shared_set = strcmp(v, "shared") == 0;
+        return true;
     case OPT_MEASURE: return measure_parse(v, &o->ref.measure, err);
     case OPT_CACHE: o->cache_dir = v; return true;
     case OPT_NO_CACHE: o->no_cache = true; return true;
@@ -170,7 +178,7 @@ bool cli_parse(const CliCommand *cmd, int argc, char **argv, CliOptions *o, Erro
     o->repeat = 1;
     o->light = 1;
     o->frustum = 24;
-    o->ref = (ReferenceParams){MEASURE_VISIBILITY, 1024, SAMPLING_R2, 1};
+    o->ref = (ReferenceParams){MEASURE_VISIBILITY, 1024, SAMPLING_R2, 1, false};
     for (int i = 1; i < argc; i++) {
         if (argv[i][0] == '-' && argv[i][1] != '\0') {
             if (!parse_option(cmd, argv, &i, argc, o, err)) return false;

@@ -38,6 +38,16 @@ int sampling_batch_of(SamplingPattern p, int i, int count);
 
 /* Seed of the stream of one pixel (or any other id). */
 uint32_t sampling_stream(uint32_t seed, uint32_t id);
+/* The stream of view sample `id` under a sample-set choice: its own,
+ * sampling_stream(seed, id), or with `shared` one stream for every view
+ * sample of the frame (the id SAMPLING_SHARED_ID, which no view sample has),
+ * the single light-sample set of Eisemann & Décoret 2007 and Sintorn et al.
+ * 2008 (course §5.3.3). */
+#define SAMPLING_SHARED_ID 0xFFFFFFFFu
+static inline uint32_t sampling_set_stream(uint32_t seed, bool shared, uint32_t id)
+{
+    return sampling_stream(seed, shared ? SAMPLING_SHARED_ID : id);
+}
 /* Sample i of `count` in a stream. */
 void sample_2d(SamplingPattern p, uint32_t stream, int i, int count, float *u, float *v);
 

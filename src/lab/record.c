@@ -85,6 +85,7 @@ static void write_reference(JsonWriter *w, const RunReport *r)
     json_string(w, "std_error", ref_error_estimator_name(r->ref->estimator));
     json_int(w, "batches", r->ref->batches);
     json_int(w, "seed", p->seed);
+    json_string(w, "sample_set", p->shared_set ? "shared" : "per_view_sample");
     json_int(w, "rays", r->ref->rays);
     hash_hex(r->ref_info->key, hex);
     json_string(w, "key", hex);
@@ -328,6 +329,7 @@ static void print_reference(const RunReport *r, FILE *fp)
     else
         fprintf(fp, "%d %s samples (std error: independent samples')", ref->params.samples,
                 sampling_pattern_name(ref->params.pattern));
+    if (ref->params.shared_set) fprintf(fp, ", one set shared by every view sample");
     fprintf(fp, ", %.3g s (%s), %.3g Mrays/s\n", r->ref_info->seconds, ref_origin_name(r->ref_info->origin),
             r->ref_info->rays_per_second * 1e-6);
 }

@@ -221,7 +221,7 @@ static bool measured(const StabCase *c, const StabSettings *st) { return !(st->q
 
 static RefRequest reference_request(const StabCase *c, const StabSettings *st)
 {
-    return (RefRequest){0, {MEASURE_VISIBILITY, c && c->heavy ? 16 : st->ref_samples, SAMPLING_R2, 1}, NULL};
+    return (RefRequest){0, {MEASURE_VISIBILITY, c && c->heavy ? 16 : st->ref_samples, SAMPLING_R2, 1, false}, NULL};
 }
 
 /* metrics.h's lit region: reference V >= 0.99. */

@@ -183,7 +183,7 @@ int sl_lab_open(lua_State *L)
 /* ---- options ------------------------------------------------------------ */
 
 static const char *const option_names[] = {"technique", "params", "light", "repeats", "warmup", "samples", "pattern",
-                                           "seed", "measure", "cache", "out", "png", "exr", "print",
+                                           "seed", "sample_set", "measure", "cache", "out", "png", "exr", "print",
                                            "time_budget", "error_scale", NULL};
 
 static void check_option_names(lua_State *L, int idx, const char *method)
@@ -265,12 +265,16 @@ typedef struct Options {
 static void read_reference_options(lua_State *L, int idx, Options *o)
 {
     Error err;
-    o->req.ref = (ReferenceParams){MEASURE_VISIBILITY, 1024, SAMPLING_R2, 1};
+    o->req.ref = (ReferenceParams){MEASURE_VISIBILITY, 1024, SAMPLING_R2, 1, false};
     o->req.ref.samples = opt_int(L, idx, "samples", 1024, 1, REFERENCE_MAX_SAMPLES);
     o->req.ref.seed = (uint32_t)opt_int(L, idx, "seed", 1, 0, 2147483647);
     const char *pattern = opt_string(L, idx, "pattern"), *measure = opt_string(L, idx, "measure");
     if (pattern && !sampling_pattern_parse(pattern, &o->req.ref.pattern, &err)) sl_raise(L, &err);
     if (measure && !measure_parse(measure, &o->req.ref.measure, &err)) sl_raise(L, &err);
+    const char *set = opt_string(L, idx, "sample_set");
+    if (set && strcmp(set, "shared") != 0 && strcmp(set, "per_view_sample") != 0)
+        luaL_error(L, "sample_set '%s' is not one of: per_view_sample, shared", set);
+    o->req.ref.shared_set = set && strcmp(set, "shared") == 0;
     lua_getfield(L, idx, "cache");
     if (lua_isnil(L, -1) || (lua_isboolean(L, -1) && lua_toboolean(L, -1))) {
         refcache_default_dir(o->cache_dir, sizeof o->cache_dir);

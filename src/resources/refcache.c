@@ -1,6 +1,7 @@
 /* refcache.c -- reference cache files. Layout (little-endian, native):
  *   "SLREF\0\0\2" | key u64 | width, height, channels, measure, samples,
- *   pattern i32 | seed u32 | rays_per_sample, estimator, batches i32 | pad i32 |
+ *   pattern i32 | seed u32 | rays_per_sample, estimator, batches, shared_set i32 (0 or 1: formerly
+ *   padding, always 0, so older entries read as per-view-sample sets) |
  *   rays i64 | value floats | std_error floats | FNV-1a 64 checksum of
  *   everything before it. Version 2: std_error by randomised QMC batches
  *   (version 1's smoothed binomial entries are read as corrupt and recomputed). */
@@ -17,7 +18,7 @@ typedef struct Header {
     uint64_t key;
     int32_t width, height, channels, measure, samples, pattern;
     uint32_t seed;
-    int32_t rays_per_sample, estimator, batches, pad;
+    int32_t rays_per_sample, estimator, batches, shared_set;
     int64_t rays;
 } Header;
 
@@ -49,7 +50,7 @@ static bool header_sane(const Header *h, uint64_t key)
            h->measure >= 0 && h->measure <= MEASURE_IRRADIANCE && h->pattern >= 0 &&
            h->pattern < SAMPLING_PATTERN_COUNT && h->samples > 0 && h->rays_per_sample > 0 &&
            h->rays_per_sample <= h->samples && h->estimator >= 0 && h->estimator < REF_ERROR_ESTIMATOR_COUNT &&
-           h->batches >= 1 && h->batches <= SAMPLING_MAX_BATCHES;
+           h->batches >= 1 && h->batches <= SAMPLING_MAX_BATCHES && (h->shared_set == 0 || h->shared_set == 1);
 }
 
 RefcacheStatus refcache_read(const char *path, uint64_t key, Reference *ref, Error *why)
@@ -81,7 +82,7 @@ RefcacheStatus refcache_read(const char *path, uint64_t key, Reference *ref, Err
     }
     memcpy(ref->value.data, buf + sizeof h, n * sizeof(float));
     memcpy(ref->std_error.data, buf + sizeof h + n * sizeof(float), n * sizeof(float));
-    ref->params = (ReferenceParams){(Measure)h.measure, h.samples, (SamplingPattern)h.pattern, h.seed};
+    ref->params = (ReferenceParams){(Measure)h.measure, h.samples, (SamplingPattern)h.pattern, h.seed, h.shared_set == 1};
     ref->rays = h.rays;
     ref->rays_per_sample = h.rays_per_sample;
     ref->estimator = (RefErrorEstimator)h.estimator;
@@ -105,7 +106,7 @@ bool refcache_write(const char *dir, const char *path, uint64_t key, const Refer
                 .measure = (int32_t)ref->params.measure, .samples = ref->params.samples,
                 .pattern = (int32_t)ref->params.pattern, .seed = ref->params.seed,
                 .rays_per_sample = ref->rays_per_sample, .estimator = (int32_t)ref->estimator,
-                .batches = ref->batches, .rays = ref->rays};
+                .batches = ref->batches, .shared_set = ref->params.shared_set, .rays = ref->rays};
     memcpy(h.magic, MAGIC, 8);
     AtomicFile af;
     if (!atomic_open(&af, path, err)) return false;

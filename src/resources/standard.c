@@ -207,6 +207,7 @@ uint64_t reference_key(const Scene *scene, const RefRequest *req)
     hash_u64(&h, (uint64_t)req->params.samples);
     hash_u64(&h, (uint64_t)req->params.pattern);
     hash_u64(&h, req->params.seed);
+    if (req->params.shared_set) hash_u64(&h, 1); /* per-view-sample keys stay as they were */
     return hash_final(&h);
 }
 
@@ -285,8 +286,9 @@ const Reference *res_reference(ResourceManager *rm, const Scene *scene, const Re
     info->key = reference_key(scene, req);
     RefArgs a = {rm, scene, req, info};
     char desc[160];
-    snprintf(desc, sizeof desc, "light %d, %s, %d %s samples", req->light_index + 1,
-             measure_name(req->params.measure), req->params.samples, sampling_pattern_name(req->params.pattern));
+    snprintf(desc, sizeof desc, "light %d, %s, %d %s samples%s", req->light_index + 1,
+             measure_name(req->params.measure), req->params.samples, sampling_pattern_name(req->params.pattern),
+             req->params.shared_set ? " (one shared set)" : "");
     const Reference *ref = rm_acquire(rm, &kind_reference, info->key, desc, build_reference, &a, err);
     if (ref && info->origin != REF_REUSED) rm_log_note(rm, kind_reference.name, info->key, ref_origin_name(info->origin));
     return ref;

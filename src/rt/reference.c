@@ -262,7 +262,7 @@ static int trace_sample(const RefJob *j, int s, struct RTCIntersectContext *ctx,
 {
     vec3 p = j->vs->p_world[s], ng = j->vs->n_geom_world[s];
     vec3 org = v3_madd(p, ng, rt_ray_offset(j->extent, p));
-    uint32_t stream = sampling_stream(j->p->seed, (uint32_t)s);
+    uint32_t stream = sampling_set_stream(j->p->seed, j->p->shared_set, (uint32_t)s);
     int nc = j->out->value.channels, m = j->out->batches;
     Accum a = {0};
     int rays = 0;

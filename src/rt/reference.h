@@ -18,6 +18,19 @@ typedef struct ReferenceParams {
     int samples;             /* light samples per view sample (delta lights trace one) */
     SamplingPattern pattern;
     uint32_t seed;
+    /* false (the default): every view sample draws its own stream,
+     * sampling_stream(seed, s); true (--sample-set shared): all draw the one
+     * stream sampling_set_stream(seed, true, s), so on rect, disk and
+     * textured lights every view sample traces toward the same light points
+     * (a sphere light's are directions from each, cone sampling). The
+     * standard error stays honest per view sample: the shared stream is
+     * still cut into the same M independent randomisations (core/sampling.h),
+     * each batch a shared set too, so a sample's batch means are independent
+     * and their spread over sqrt(M) estimates its error as before; what
+     * changes is that neighbouring samples' errors are correlated (the same
+     * points: structured banding, not independent noise), so an image's mean
+     * error does not average down over its samples. */
+    bool shared_set;
 } ReferenceParams;
 
 #define REFERENCE_MAX_SAMPLES 1048576

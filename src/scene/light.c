@@ -106,11 +106,16 @@ static vec3 rect_point(const Light *l, float u, float v)
     return v3_madd(q, l->up, (v - 0.5f) * l->height);
 }
 
+vec3 light_sample_colour(const Light *l, float u, float v)
+{
+    return l->kind == LIGHT_TEXTURED_RECT ? emission_lookup(l, u, v) : v3(1, 1, 1);
+}
+
 static LightSample sample_rect(const Light *l, vec3 p, float u, float v)
 {
     vec3 e = radiance(l);
     if (l->kind != LIGHT_TEXTURED_RECT) return area_sample(l, p, rect_point(l, u, v), l->width * l->height, e);
-    vec3 tex = emission_lookup(l, u, v);
+    vec3 tex = light_sample_colour(l, u, v);
     LightSample s = area_sample(l, p, rect_point(l, u, v), l->width * l->height, v3_mul(e, tex));
     s.vis_weight = tex;
     return s;
@@ -136,6 +141,51 @@ static LightSample sample_disk(const Light *l, vec3 p, float u, float v)
     v3_basis(l->direction, &t, &b);
     vec3 q = v3_add(l->position, v3_scale(v3_add(v3_scale(t, x), v3_scale(b, y)), l->radius));
     return area_sample(l, p, q, PI_F * l->radius * l->radius, radiance(l));
+}
+
+bool light_plane_axes(const Light *l, vec3 *centre, vec3 *e1, vec3 *e2)
+{
+    *centre = l->position;
+    if (l->kind == LIGHT_RECT || l->kind == LIGHT_TEXTURED_RECT) {
+        *e1 = rect_right(l);
+        *e2 = l->up;
+        return true;
+    }
+    if (l->kind == LIGHT_DISK) {
+        v3_basis(l->direction, e1, e2);
+        return true;
+    }
+    return false;
+}
+
+void light_plane_point(const Light *l, float u, float v, double st[2])
+{
+    if (l->kind == LIGHT_DISK) {
+        float x, y;
+        concentric_disk(u, v, &x, &y);
+        st[0] = (double)x * l->radius;
+        st[1] = (double)y * l->radius;
+        return;
+    }
+    st[0] = ((double)u - 0.5) * l->width; /* rect_point's offsets */
+    st[1] = ((double)v - 0.5) * l->height;
+}
+
+void light_bitmask_visibility(const vec3 *colour, const uint64_t *kept, const uint64_t *blocked, int n, int nc,
+                              float *out)
+{
+    double all[3] = {0, 0, 0}, lit[3] = {0, 0, 0};
+    for (int i = 0; i < n; i++) {
+        uint64_t bit = 1ull << (i % 64);
+        if (!(kept[i / 64] & bit)) continue;
+        const float w[3] = {colour[i].x, colour[i].y, colour[i].z};
+        bool unblocked = !(blocked[i / 64] & bit);
+        for (int c = 0; c < nc; c++) {
+            all[c] += w[c];
+            lit[c] += unblocked ? w[c] : 0.0;
+        }
+    }
+    for (int c = 0; c < nc; c++) out[c] = all[c] > 0.0 ? (float)(lit[c] / all[c]) : 1.0f;
 }
 
 LightSample light_sample(const Light *l, vec3 p, float u, float v)

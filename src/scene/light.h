@@ -38,6 +38,27 @@ LightSample light_sample(const Light *light, vec3 p_world, float u, float v);
 /* The light's centre sample (the point-light limit that `hard` tests). */
 LightSample light_sample_center(const Light *light, vec3 p_world);
 bool light_is_delta(const Light *light);
+/* The colour of light sample (u, v), its visibility's weight (LightSample
+ * vis_weight): a textured rect's emission texel RGB there, white for every
+ * other light. */
+vec3 light_sample_colour(const Light *light, float u, float v);
+/* Visibility per channel (out[0..nc), nc 1 or 3) of n light samples with
+ * those colours, of which the bits set in `kept` count and those set in
+ * `blocked` are blocked (bit i of word i / 64): the kept unblocked samples'
+ * colours summed over all kept samples' colours, channel by channel, the
+ * reference's own ratio (rt/reference.c finish: sum w x / sum w with w the
+ * sample's vis_weight; a channel whose colours sum to 0 has nothing to
+ * block and is 1, and so is a set with no kept sample). */
+void light_bitmask_visibility(const vec3 *colour, const uint64_t *kept, const uint64_t *blocked, int n, int nc,
+                              float *out);
+/* A planar light's (rect, textured rect, disk) own frame: its centre and two
+ * orthonormal axes in its plane (world); false for the others, whose
+ * samples are not fixed points (a sphere light's are directions in the cone
+ * from each p). */
+bool light_plane_axes(const Light *light, vec3 *centre, vec3 *e1, vec3 *e2);
+/* Sample (u, v)'s point on a planar light in those axes' coordinates (world
+ * units): the point light_sample aims at, whatever p. */
+void light_plane_point(const Light *light, float u, float v, double st[2]);
 SampleClass light_classify(const Light *light, vec3 p_world, vec3 n_world);
 /* True when the tangent plane of (p_world, n_world) cuts the light: part of
  * its points (a sphere light: of the cone of directions it subtends) lies

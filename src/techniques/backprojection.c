@@ -24,7 +24,10 @@
  *     (backproject_light_scale, L = k (x - u));
  *  3. accumulated over the light's N samples (4 tiles^2 on the RGSS
  *     tiling, backproject_light_sample): bitmask = the union of the
- *     samples each polygon covers, V = 1 - popcount / N (§5.2.3.2, fusion
+ *     samples each polygon covers, V = 1 - popcount / N, per channel the
+ *     unset samples' colours over all samples' on a textured light
+ *     (light_bitmask_visibility; accumulate=area, which cannot say which
+ *     samples are covered, refuses it) (§5.2.3.2, fusion
  *     exact up to the sample count); area = each polygon's covered share
  *     summed, V = 1 - min(1, sum) (§5.2.3.1's summed areas, measured by the
  *     same samples: over-occludes where polygons overlap); contour's loops
@@ -157,6 +160,7 @@ static const char *const ms_aux[] = {"class", "level", NULL};
 #define BP_GRID 16
 typedef struct FaceSamples {
     float x[BACKPROJECT_MAX_SAMPLES], y[BACKPROJECT_MAX_SAMPLES];
+    vec3 colour[BACKPROJECT_MAX_SAMPLES]; /* light_sample_colour: a textured rect's texel, else white */
     short start[BP_GRID * BP_GRID + 1];
     short index[BACKPROJECT_MAX_SAMPLES];
     double x0, y0, cell_x, cell_y; /* the grid's corner and cell size */
@@ -174,6 +178,8 @@ typedef struct BpState {
     SmapBias bias;
     int occluder, gaps, accumulate, budget, samples;
     int early_out;
+    int channels;             /* ctx->channels: 3 for a textured light's colours */
+    uint64_t all[BP_WORDS];   /* every light sample's bit */
     bool blend, classify;     /* classify: aux `class` precedes `level` */
     const MinMaxLevels *mssm; /* NULL: the pyramid's aligned nodes only (backprojection, hsm) */
     int base;                 /* the pyramid level mssm is built on */
@@ -191,7 +197,7 @@ static int grid_cell(double v, double v0, double cell)
     return c >= 0.0 ? (int)fmin(c, BP_GRID - 1) : 0; /* NaN compares false: 0 */
 }
 
-static void face_samples(const SoftLight *L, int tiles, int n, FaceSamples *fs)
+static void face_samples(const Light *light, const SoftLight *L, int tiles, int n, FaceSamples *fs)
 {
     int count[BP_GRID * BP_GRID] = {0}, cell[BACKPROJECT_MAX_SAMPLES];
     fs->x0 = -L->half_x;
@@ -201,6 +207,9 @@ static void face_samples(const SoftLight *L, int tiles, int n, FaceSamples *fs)
     for (int k = 0; k < n; k++) {
         double a, b;
         backproject_light_sample(tiles, k, L->square, &a, &b);
+        /* xi = (a, b) spans the rect's half-axes right and up (softmap.c light_axes): the texel at
+         * light_sample's (u, v) = ((a + 1) / 2, (b + 1) / 2) */
+        fs->colour[k] = light_sample_colour(light, (float)((a + 1.0) / 2.0), (float)((b + 1.0) / 2.0));
         fs->x[k] = (float)(L->M[0][0] * a + L->M[0][1] * b);
         fs->y[k] = (float)(L->M[1][0] * a + L->M[1][1] * b);
         cell[k] = grid_cell(fs->y[k], fs->y0, fs->cell_y) * BP_GRID + grid_cell(fs->x[k], fs->x0, fs->cell_x);
@@ -274,6 +283,10 @@ static bool prepare_variant(const TechContext *ctx, Variant var, const char *tec
     const double *p = ctx->params;
     int base;
     if (!mssm_base(var, p, &base, err)) return false;
+    if (ctx->light->kind == LIGHT_TEXTURED_RECT && p[P_ACCUMULATE] == ACC_AREA)
+        return error_set(err, "accumulate=area cannot colour light %d (textured_rect): summed areas do not say which "
+                              "light samples are covered, so not which texels; use accumulate=bitmask",
+                         ctx->light_index + 1);
     BpState *st = calloc(1, sizeof *st);
     if (!st) return error_set(err, "out of memory");
     st->base = base;
@@ -297,7 +310,10 @@ static bool prepare_variant(const TechContext *ctx, Variant var, const char *tec
     st->blend = st->classify && p[P_BLEND] != 0.0;
     int tiles = (int)p[P_TILES];
     st->samples = 4 * tiles * tiles;
-    for (int k = 0; k < map->num_faces; k++) face_samples(&st->sm.face[k].light, tiles, st->samples, &st->face[k]);
+    st->channels = ctx->channels;
+    for (int k = 0; k < st->samples; k++) st->all[k / 64] |= 1ull << (k % 64);
+    for (int k = 0; k < map->num_faces; k++)
+        face_samples(ctx->light, &st->sm.face[k].light, tiles, st->samples, &st->face[k]);
     *state = st;
     return true;
 }
@@ -550,14 +566,6 @@ static bool poly_unknown(const Poly *p, bool rect)
     return false;
 }
 
-/* The covered share of the light's samples in mask. */
-static double mask_share(const BpState *st, const uint64_t *mask)
-{
-    int marked = 0;
-    for (int k = 0; k < BP_WORDS; k++) marked += __builtin_popcountll(mask[k]);
-    return (double)marked / st->samples; /* samples = 4 tiles^2 >= 4 */
-}
-
 /* What a receiver's occluders cover, over its polygons and layers. */
 typedef struct Occlusion {
     uint64_t mask[BP_WORDS]; /* bitmask: the light samples covered, united */
@@ -573,6 +581,24 @@ static double share_visibility(double covered, bool unknown)
 {
     if (covered >= 1.0) return 0.0;
     return unknown ? NAN : 1.0 - nan_clamp(covered, 0.0, 1.0);
+}
+
+/* accumulate=area: the covered share's V in every channel. */
+static void area_visibility(const BpState *st, double covered, bool unknown, double *v)
+{
+    for (int c = 0; c < st->channels; c++) v[c] = share_visibility(covered, unknown);
+}
+
+/* accumulate=bitmask: V per channel of the samples left unset in mask, their
+ * colours over all samples' (light_bitmask_visibility, the reference's
+ * ratio; 1 - popcount / N on a white light), with share_visibility's rules. */
+static void mask_visibility(const BpState *st, const FaceSamples *fs, const uint64_t *mask, bool unknown, double *v)
+{
+    int marked = 0;
+    for (int k = 0; k < BP_WORDS; k++) marked += __builtin_popcountll(mask[k]);
+    float lit[3];
+    light_bitmask_visibility(fs->colour, st->all, mask, st->samples, st->channels, lit);
+    for (int c = 0; c < st->channels; c++) v[c] = marked >= st->samples ? 0.0 : unknown ? NAN : lit[c];
 }
 
 /* ---- contour occluders (Guennebaud et al. 2007, course §5.2.3.3) ----------
@@ -714,13 +740,14 @@ static void window_occlusion(const BpState *st, const SoftFace *f, const FaceSam
         }
 }
 
-/* 1 - the occluded share of the light's samples (area: the summed shares;
- * contour's exact); NaN when an occluder that may exist is unknown, unless
- * the known ones already cover every sample (occluders only add). */
-static double occlusion_visibility(const BpState *st, const Occlusion *o)
+/* V of o per channel into v: bitmask the samples left unset (their colours
+ * on a textured light), area 1 - the summed shares (contour's exact); NaN
+ * when an occluder that may exist is unknown, unless the known ones already
+ * cover every sample (occluders only add). */
+static void occlusion_visibility(const BpState *st, const FaceSamples *fs, const Occlusion *o, double *v)
 {
-    if (st->accumulate == ACC_BITMASK) return share_visibility(mask_share(st, o->mask), o->unknown);
-    return share_visibility(st->occluder == OCC_CONTOUR ? o->share : (double)o->count / st->samples, o->unknown);
+    if (st->accumulate == ACC_BITMASK) mask_visibility(st, fs, o->mask, o->unknown, v);
+    else area_visibility(st, st->occluder == OCC_CONTOUR ? o->share : (double)o->count / st->samples, o->unknown, v);
 }
 
 /* V over the search window at one budget level, occluders taken from every
@@ -729,7 +756,8 @@ static double occlusion_visibility(const BpState *st, const Occlusion *o)
  * layer), and a layer's lexel occludes where it passes the shadow test, i.e.
  * lies nearer the light than the receiver; empty lexels (+INFINITY: a
  * texel with fewer surfaces) never do. */
-static double level_visibility(const BpState *st, const SmapReceiver *r, int wi, int wj, int level, Window *w)
+static void level_visibility(const BpState *st, const SmapReceiver *r, int wi, int wj, int level, Window *w,
+                             double *v)
 {
     const SoftFace *f = &st->sm.face[r->mc.face];
     Occlusion o = {.unknown = false};
@@ -737,11 +765,16 @@ static double level_visibility(const BpState *st, const SmapReceiver *r, int wi,
         load_window(st, &st->layer[k], r, wi, wj, level, w);
         window_occlusion(st, f, &st->face[r->mc.face], w, &o);
     }
-    return occlusion_visibility(st, &o);
+    occlusion_visibility(st, &st->face[r->mc.face], &o, v);
 }
 
-/* Visibility of one receiver; *cls its path (aux `class`), *level the budget
- * level read. The search area and both early outs read layer 0 only, and
+static void fill(float *out, int channels, float v)
+{
+    for (int c = 0; c < channels; c++) out[c] = v;
+}
+
+/* Visibility of one receiver into out[0..channels); *cls its path (aux
+ * `class`), *level the budget level read. The search area and both early outs read layer 0 only, and
  * stay exact with layers: per texel layer 0 is the nearest surface, so its
  * z_min over an area is every layer's (no blocker of any layer lies nearer
  * the light than z_b; lit where none can block); the umbra early out needs
@@ -749,7 +782,7 @@ static double level_visibility(const BpState *st, const SmapReceiver *r, int wi,
  * passes, is one (deeper layers only add occluders; their z_max would be
  * wrong to use, an empty texel or a surface behind p failing an area that
  * layer 0 already closes). */
-static float visibility(const BpState *st, const SmapReceiver *r, Window *w, int *cls, int *level)
+static void visibility(const BpState *st, const SmapReceiver *r, Window *w, int *cls, int *level, float *out)
 {
     double z_b, t;
     bool may_block = backproject_search_in(&st->sm, ms_bounds, st, r, &z_b);
@@ -757,15 +790,18 @@ static float visibility(const BpState *st, const SmapReceiver *r, Window *w, int
     backproject_search_halfwidth(&st->sm, r, z_b, &wi, &wj);
     *level = 0;
     *cls = CLASS_LIT;
-    if (!may_block && st->early_out != EARLY_NONE) return 1.0f; /* z_p <= z_min over the search area: lit */
+    if (!may_block && st->early_out != EARLY_NONE) { fill(out, st->channels, 1.0f); return; } /* z_p <= z_min: lit */
     *cls = CLASS_UMBRA;
-    if (st->early_out == EARLY_BOTH && area_occludes(st, r, wi, wj)) return 0.0f;
+    if (st->early_out == EARLY_BOTH && area_occludes(st, r, wi, wj)) { fill(out, st->channels, 0.0f); return; }
     *cls = CLASS_BACKPROJECTED;
     *level = budget_level(st, wi, wj, &t);
-    double v = level_visibility(st, r, wi, wj, *level, w);
-    if (st->blend && t > 0.0) /* course §5.2.3.5: blending two levels hides the switch */
-        v = (1.0 - t) * v + t * level_visibility(st, r, wi, wj, *level + 1, w);
-    return (float)v;
+    double v[3], next[3];
+    level_visibility(st, r, wi, wj, *level, w, v);
+    if (st->blend && t > 0.0) { /* course §5.2.3.5: blending two levels hides the switch */
+        level_visibility(st, r, wi, wj, *level + 1, w, next);
+        for (int c = 0; c < st->channels; c++) v[c] = (1.0 - t) * v[c] + t * next[c];
+    }
+    for (int c = 0; c < st->channels; c++) out[c] = (float)v[c];
 }
 
 static void bp_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
@@ -776,13 +812,11 @@ static void bp_evaluate(const void *state, const TechContext *ctx, int begin, in
     for (int s = begin; s < end; s++) {
         if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
         SmapReceiver r;
-        float v = 1.0f; /* outside the map nothing is known to block: lit, as a lit early out */
+        float *v = out + (size_t)(s - begin) * (size_t)ctx->channels;
         int level = 0, cls = CLASS_LIT;
         if (w && smap_receiver(st->sm.map, &st->bias, ctx->vs->p_world[s], ctx->vs->n_geom_world[s], &r))
-            v = visibility(st, &r, w, &cls, &level);
-        else if (!w)
-            v = NAN; /* out of memory: no value, never a made-up one */
-        tech_store(ctx, out, begin, s, v);
+            visibility(st, &r, w, &cls, &level, v);
+        else fill(v, ctx->channels, w ? 1.0f : NAN); /* outside the map: lit (a lit early out); no memory: no value */
         if (!ctx->aux) continue;
         if (st->classify) ctx->aux[(size_t)s * channels] = (float)cls;
         ctx->aux[(size_t)s * channels + channels - 1] = (float)level;
@@ -798,8 +832,8 @@ static const ParamCondition bp_conditions[] = {
 
 /* What the four techniques share. */
 #define BP_TECHNIQUE                                                                                                \
-    .conditions = bp_conditions, .family = "soft", .rgb = false,                                                     \
-    .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),                               \
+    .conditions = bp_conditions, .family = "soft", .rgb = true,                                                      \
+    .lights = LIGHTS_AREA,                                                                                            \
     .main_param = "budget", /* course Fig. 5.11: accuracy against the texel budget */                                \
         .evaluate = bp_evaluate, .release = free
 

@@ -44,7 +44,9 @@
  * `near_edge` (aux) counts the light samples whose projection lies within
  * EXACT_AMBIGUOUS_TAN of a projected edge that steps the counts (a silhouette
  * edge from org, or a clipped triangle's edge on the clip plane), and those left out off the frame's axis: there the float ray test and the
- * projected predicate may disagree. */
+ * projected predicate may disagree. On a coloured (textured rect) light the
+ * lit samples, those of the least count, weigh by their colours
+ * (light_bitmask_visibility, the reference's ratio). */
 #include <math.h>
 #include <stdlib.h>
 #include "techniques/exact_soft.h"
@@ -125,14 +127,36 @@ static void add_triangle(void *user, const vec3 *tri, bool front_only)
     for (int k = 0; k < np; k++) add_edge(user, poly[k], poly[(k + 1) % np], w);
 }
 
-/* Visibility of one view sample; *near counts its ambiguous light samples. */
-static float sample_visibility(const ExactCasters *cs, const TechContext *ctx, int s, Counters *k, int *near)
+/* The visibility per channel of the kept samples whose count is the least
+ * (the lit ones): light_bitmask_visibility of the others as blocked. */
+static void lit_at_least(const Counters *k, int best, int channels, float *out)
+{
+    const LightPoints *lp = &k->lp;
+    uint64_t kept[EXACT_MAX_SAMPLES / 64] = {0}, blocked[EXACT_MAX_SAMPLES / 64] = {0};
+    vec3 colour[EXACT_MAX_SAMPLES];
+    for (int i = 0; i < lp->n; i++) {
+        kept[i / 64] |= (uint64_t)lp->above[i] << (i % 64);
+        blocked[i / 64] |= (uint64_t)(k->rel[i] != k->rel[best]) << (i % 64);
+        colour[i] = lp->ls[i].vis_weight;
+    }
+    light_bitmask_visibility(colour, kept, blocked, lp->n, channels, out);
+}
+
+static void store_all(float *out, int channels, float v)
+{
+    for (int c = 0; c < channels; c++) out[c] = v;
+}
+
+/* Visibility of one view sample into out[0..channels); *near counts its
+ * ambiguous light samples. */
+static void sample_visibility(const ExactCasters *cs, const TechContext *ctx, int s, Counters *k, int *near,
+                              float *out)
 {
     LightPoints *lp = &k->lp;
     *near = 0;
-    if (!exact_begin(cs, ctx, s, lp)) return 1.0f; /* no caster reaches the light's cone: nothing blocks */
+    if (!exact_begin(cs, ctx, s, lp)) { store_all(out, ctx->channels, 1.0f); return; } /* nothing reaches the cone */
     exact_draw(lp, ctx, s);
-    if (lp->kept == 0) return exact_sliver_visibility(cs, ctx, s, lp);
+    if (lp->kept == 0) { store_all(out, ctx->channels, exact_sliver_visibility(cs, ctx, s, lp)); return; }
     int first = 0;
     while (!lp->above[first]) first++;
     k->r = lp->x[first]; /* counters relative to the first kept sample */
@@ -147,10 +171,8 @@ static float sample_visibility(const ExactCasters *cs, const TechContext *ctx, i
         if (lp->above[i] && k->rel[i] < k->rel[best]) best = i;
     for (int i = 0; i < lp->n; i++) *near += lp->above[i] && k->near[i];
     *near += lp->off_axis;
-    if (exact_occluded(cs, lp->org, &lp->ls[best])) return 0.0f; /* the least count is >= 1: all blocked */
-    int lit = 0;
-    for (int i = 0; i < lp->n; i++) lit += lp->above[i] && k->rel[i] == k->rel[best];
-    return (float)lit / (float)lp->kept;
+    if (exact_occluded(cs, lp->org, &lp->ls[best])) store_all(out, ctx->channels, 0.0f); /* least count >= 1 */
+    else lit_at_least(k, best, ctx->channels, out); /* a sample is lit where its count is the least, 0 */
 }
 
 static bool dc_prepare(const TechContext *ctx, void **state, Error *err)
@@ -184,8 +206,8 @@ static void dc_evaluate(const void *state, const TechContext *ctx, int begin, in
     for (int s = begin; s < end; s++) {
         if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
         int near = 0;
-        float v = k ? sample_visibility(cs, ctx, s, k, &near) : NAN; /* out of memory: no value */
-        tech_store(ctx, out, begin, s, v);
+        if (k) sample_visibility(cs, ctx, s, k, &near, out + (size_t)(s - begin) * (size_t)ctx->channels);
+        else tech_store(ctx, out, begin, s, NAN); /* out of memory: no value */
         if (ctx->aux) ctx->aux[s] = (float)near;
     }
     if (k) exact_scratch_free(&k->scratch);
@@ -201,8 +223,8 @@ const Technique tech_depth_complexity = {
     .params = dc_params,
     .num_params = (int)(sizeof dc_params / sizeof dc_params[0]),
     .resources = dc_resources,
-    .rgb = false,
-    .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_RECT) | LIGHT_BIT(LIGHT_DISK),
+    .rgb = true,
+    .lights = LIGHTS_AREA,
     .main_param = "samples",
     .prepare = dc_prepare,
     .evaluate = dc_evaluate,

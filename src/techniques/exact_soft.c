@@ -26,6 +26,7 @@
 #include "resources/standard.h"
 
 const char *const exact_pattern_names[] = {"r2", "stratified", "random", NULL}; /* SamplingPattern order */
+const char *const exact_sample_set_names[] = {"per_view_sample", "shared", NULL};
 
 /* A sphere around corners [first, last): their box's centre, the farthest corner. */
 static Ball bound_corners(const vec3 *p, int first, int last)
@@ -43,7 +44,8 @@ static Ball bound_corners(const vec3 *p, int first, int last)
 
 static Ball light_ball(const Light *l)
 {
-    double r = l->kind == LIGHT_RECT ? 0.5 * hypot(l->width, l->height) : l->radius;
+    bool rect = l->kind == LIGHT_RECT || l->kind == LIGHT_TEXTURED_RECT;
+    double r = rect ? 0.5 * hypot(l->width, l->height) : l->radius;
     return (Ball){d3_from(l->position), r * (1.0 + 1e-6)};
 }
 
@@ -611,7 +613,8 @@ void exact_draw(LightPoints *lp, const TechContext *ctx, int s)
 {
     vec3 p = ctx->vs->p_world[s], ng = ctx->vs->n_geom_world[s];
     SamplingPattern pat = (SamplingPattern)ctx->params[EXACT_P_PATTERN];
-    uint32_t stream = sampling_stream((uint32_t)ctx->params[EXACT_P_SEED], (uint32_t)s);
+    uint32_t stream = sampling_set_stream((uint32_t)ctx->params[EXACT_P_SEED],
+                                          ctx->params[EXACT_P_SAMPLE_SET] == EXACT_SET_SHARED, (uint32_t)s);
     lp->n = (int)ctx->params[EXACT_P_SAMPLES];
     lp->kept = lp->off_axis = 0;
     lp->lo = (P2){INFINITY, INFINITY};

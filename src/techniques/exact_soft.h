@@ -30,8 +30,10 @@
 #define EXACT_CHUNK 32           /* triangles per bounding sphere */
 
 /* The parameters both techniques start with (the reference's sampling). */
-enum { EXACT_P_SAMPLES, EXACT_P_PATTERN, EXACT_P_SEED, EXACT_NUM_SAMPLE_PARAMS };
+enum { EXACT_P_SAMPLES, EXACT_P_PATTERN, EXACT_P_SEED, EXACT_P_SAMPLE_SET, EXACT_NUM_SAMPLE_PARAMS };
+enum { EXACT_SET_PER_VIEW_SAMPLE, EXACT_SET_SHARED }; /* sample_set: ReferenceParams.shared_set */
 extern const char *const exact_pattern_names[];
+extern const char *const exact_sample_set_names[];
 #define EXACT_SAMPLE_PARAMS(min_samples, def_samples, samples_doc)                                                  \
     {"samples", PARAM_INT, def_samples, min_samples, EXACT_MAX_SAMPLES, "light samples", samples_doc, NULL},         \
         {"pattern", PARAM_ENUM, SAMPLING_R2, 0, 2, "",                                                              \
@@ -40,7 +42,11 @@ extern const char *const exact_pattern_names[];
         {"seed", PARAM_INT, 1, 0, 2147483647, "",                                                                   \
          "the light samples' seed, the reference's own (--seed): with the same N, pattern and seed the samples "   \
          "are the reference's rays",                                                                                \
-         NULL}
+         NULL},                                                                                                     \
+        {"sample_set", PARAM_ENUM, EXACT_SET_PER_VIEW_SAMPLE, 0, 1, "",                                             \
+         "per_view_sample (each view sample its own stream) or shared (one set for the frame: the same points on "  \
+         "a rect or disk light for every view sample), the reference's own (--sample-set)",                         \
+         exact_sample_set_names}
 
 typedef struct Ball {
     dvec3 centre; /* world space */

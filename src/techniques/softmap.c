@@ -14,7 +14,7 @@ static void light_axes(const Light *light, dvec3 ex, dvec3 ey, double M[2][2], b
         return;
     }
     dvec3 normal = d3_from(light->direction);
-    if (light->kind == LIGHT_RECT) {
+    if (light->kind == LIGHT_RECT || light->kind == LIGHT_TEXTURED_RECT) {
         dvec3 up = d3_from(light->up);
         a = d3_scale(d3_cross(up, normal), 0.5 * light->width);
         b = d3_scale(up, 0.5 * light->height);

@@ -8,7 +8,7 @@ bool signed_error(Lab *lab, const Image *v, int samples, Metrics *m, Image *e)
     Error err;
     RefInfo info;
     *e = (Image){0};
-    RefRequest rq = {0, {MEASURE_VISIBILITY, samples, SAMPLING_STRATIFIED, 1}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, samples, SAMPLING_STRATIFIED, 1, false}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     const uint8_t *cls = ref ? res_classes(lab_resources(lab), lab_scene(lab), 0, &err) : NULL;
     const uint8_t *term = cls ? res_terminator(lab_resources(lab), lab_scene(lab), 0, &err) : NULL;

@@ -174,7 +174,7 @@ static double reference_shadow_sum(Lab *lab, int samples)
 {
     Error err;
     RefInfo info;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, samples, SAMPLING_STRATIFIED, 1}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, samples, SAMPLING_STRATIFIED, 1, false}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     return ref ? shadow_sum(lab, &ref->value) : NAN;
 }
@@ -471,7 +471,7 @@ static double occlusion_kept(Lab *lab, const Image *v, int samples)
 {
     Error err;
     RefInfo info;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, samples, SAMPLING_STRATIFIED, 1}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, samples, SAMPLING_STRATIFIED, 1, false}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     const uint8_t *cls = ref ? res_classes(lab_resources(lab), lab_scene(lab), 0, &err) : NULL;
     if (!cls) return NAN;

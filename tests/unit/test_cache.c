@@ -22,7 +22,7 @@ static bool fetch(const char *cache, Image *copy, RefInfo *info)
     Error err;
     Lab *lab = fixture_lab("cache.lua", scene_text);
     if (!lab) return false;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1}, cache};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1, false}, cache};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, info, &err);
     bool ok = ref && image_init(copy, ref->value.width, ref->value.height, ref->value.channels, &err);
     if (ok) memcpy(copy->data, ref->value.data, image_count(copy) * sizeof(float));
@@ -89,4 +89,31 @@ TEST(test_cache_second_run_reads_it_and_corruption_is_recomputed)
     CHECK(info.origin == REF_CACHE_HIT && same(&first, &again));
     image_free(&again);
     image_free(&first);
+}
+
+/* A shared light-sample set (--sample-set shared) is its own cache entry:
+ * another key than the per-view-sample set's, read back as shared with the
+ * same values, which differ from the per-view-sample set's. */
+TEST(test_cache_keeps_the_shared_sample_set_apart)
+{
+    char cache[1024];
+    snprintf(cache, sizeof cache, "%s/cache-shared", test_tmpdir());
+    Error err;
+    RefInfo info[3];
+    Image value[3] = {{0}, {0}, {0}};
+    bool shared[3] = {false, true, true}, read_shared[3] = {false, false, false};
+    for (int k = 0; k < 3; k++) { /* a fresh lab each: the third reads the second's file */
+        Lab *lab = fixture_lab("cache.lua", scene_text);
+        CHECK(lab);
+        RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1, shared[k]}, cache};
+        const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info[k], &err);
+        CHECK(ref && image_init(&value[k], ref->value.width, ref->value.height, ref->value.channels, &err));
+        memcpy(value[k].data, ref->value.data, image_count(&value[k]) * sizeof(float));
+        read_shared[k] = ref->params.shared_set;
+        lab_close(lab);
+    }
+    CHECK(info[0].key != info[1].key && info[1].key == info[2].key);
+    CHECK(info[2].origin == REF_CACHE_HIT && read_shared[2] && !read_shared[0]);
+    CHECK(same(&value[1], &value[2]) && !same(&value[0], &value[1]));
+    for (int k = 0; k < 3; k++) image_free(&value[k]);
 }

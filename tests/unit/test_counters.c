@@ -99,7 +99,7 @@ TEST(test_counters_reference_traces_n_rays_per_sample)
     CHECK(vs && cls && casters);
     long lit = lit_candidates(lab), not_receiver = 0;
     for (long s = 0; s < (long)vs->width * vs->height; s++) not_receiver += cls[s] == SAMPLE_NOT_RECEIVER;
-    ReferenceParams p = {MEASURE_VISIBILITY, 40, SAMPLING_R2, 1};
+    ReferenceParams p = {MEASURE_VISIBILITY, 40, SAMPLING_R2, 1, false};
     Reference ref;
     WorkCounters w0, w1;
     work_snapshot(&w0);

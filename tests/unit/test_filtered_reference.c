@@ -24,7 +24,7 @@ static Scored score(Lab *lab, const char *tech, const char *list)
     Error err;
     RenderResult rr;
     RefInfo info;
-    RefRequest ref_rq = {0, {MEASURE_VISIBILITY, REF_SAMPLES, SAMPLING_R2, 1}, NULL};
+    RefRequest ref_rq = {0, {MEASURE_VISIBILITY, REF_SAMPLES, SAMPLING_R2, 1, false}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &ref_rq, &info, &err);
     const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
     const uint8_t *term = res_terminator(lab_resources(lab), lab_scene(lab), 0, &err);

@@ -320,7 +320,7 @@ static bool planes_run(Lab *lab, const char *const *params, double floor, Planes
     RenderResult r;
     if (!soft_render(lab, "cssm", params, &r)) return false;
     RefInfo info;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_STRATIFIED, 1}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_STRATIFIED, 1, false}, NULL};
     const Reference *ref = res_reference(rm, lab_scene(lab), &rq, &info, &err);
     const ViewSamples *vs = res_view_samples(rm, lab_scene(lab), &err);
     const uint8_t *cls = res_classes(rm, lab_scene(lab), 0, &err);

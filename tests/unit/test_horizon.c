@@ -53,7 +53,7 @@ static const Reference *reference(Lab *lab, Measure measure)
 {
     Error err;
     RefInfo info;
-    RefRequest rq = {0, {measure, SAMPLES, SAMPLING_R2, 3}, NULL};
+    RefRequest rq = {0, {measure, SAMPLES, SAMPLING_R2, 3, false}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     if (!ref) printf("    reference: %s\n", err.msg);
     return ref;
@@ -397,7 +397,7 @@ TEST(test_horizon_sliver_above_horizon_sees_its_occluder)
     CHECK(lab);
     Error err;
     RefInfo info;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, 16, SAMPLING_R2, 3}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, 16, SAMPLING_R2, 3, false}, NULL};
     const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
     const uint8_t *term = res_terminator(lab_resources(lab), lab_scene(lab), 0, &err);
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);

@@ -72,7 +72,7 @@ static const Reference *reference(Lab *lab, const uint8_t **cls)
 {
     Error err;
     RefInfo info;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, REF_SAMPLES, SAMPLING_STRATIFIED, 1}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, REF_SAMPLES, SAMPLING_STRATIFIED, 1, false}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     *cls = ref ? res_classes(lab_resources(lab), lab_scene(lab), 0, &err) : NULL;
     if (!*cls) printf("    reference: %s\n", err.msg);

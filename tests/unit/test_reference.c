@@ -82,7 +82,7 @@ static const Reference *reference(Lab *lab, int samples, SamplingPattern pattern
 {
     Error err;
     RefInfo info;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, samples, pattern, 7}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, samples, pattern, 7, false}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     if (!ref) printf("    reference: %s\n", err.msg);
     return ref;

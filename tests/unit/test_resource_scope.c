@@ -112,7 +112,7 @@ TEST(test_frame_time_counts_reused_technique_resources)
     CHECK(hard);
     double params[TECH_MAX_PARAMS];
     tech_params_default(hard, params);
-    CompareRequest rq = {hard, params, 0, 2, 1, false, {MEASURE_VISIBILITY, 16, SAMPLING_R2, 1}, NULL, 0.0, 0.0};
+    CompareRequest rq = {hard, params, 0, 2, 1, false, {MEASURE_VISIBILITY, 16, SAMPLING_R2, 1, false}, NULL, 0.0, 0.0};
     CompareResult first, second;
     CHECK(lab_compare(lab, &rq, &first, &err));
     CHECK(lab_compare(lab, &rq, &second, &err));
@@ -217,7 +217,7 @@ static bool compare_tech(Lab *lab, const char *name, const char *const *assignme
     static double params[TECH_MAX_PARAMS];
     const Technique *t = tech_find(name, &err);
     if (!t || !set_params(t, assignments, params, &err)) return false;
-    CompareRequest rq = {t, params, 0, repeat, 0, false, {MEASURE_VISIBILITY, 16, SAMPLING_R2, 1}, NULL, 0.0, 0.0};
+    CompareRequest rq = {t, params, 0, repeat, 0, false, {MEASURE_VISIBILITY, 16, SAMPLING_R2, 1, false}, NULL, 0.0, 0.0};
     return lab_compare(lab, &rq, out, &err);
 }
 

@@ -244,7 +244,7 @@ static bool shadow_error(Lab *lab, const char *const *assign, int n, ShadowError
     const ViewSamples *vs = res_view_samples(lab_resources(lab), sc, &err);
     const uint8_t *cls = res_classes(lab_resources(lab), sc, 0, &err);
     RefInfo info;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, 256, SAMPLING_R2, 7}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, 256, SAMPLING_R2, 7, false}, NULL};
     const Reference *ref = vs && cls ? res_reference(lab_resources(lab), sc, &rq, &info, &err) : NULL;
     RenderResult rr;
     if (!ref || !render(lab, "single_sample_rt", assign, n, &rr)) return false;

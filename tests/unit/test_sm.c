@@ -258,7 +258,7 @@ static double pcf_penumbra_rmse(Lab *lab, const char *K, double *all_rmse)
     RenderResult r;
     const char *p[] = {K, "map_size=1024"};
     RefInfo info;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, 64, SAMPLING_R2, 1, false}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
     const uint8_t *term = res_terminator(lab_resources(lab), lab_scene(lab), 0, &err);

@@ -101,7 +101,7 @@ static Fusion fusion(Lab *lab, const char *const *params)
     Metrics m;
     if (!soft_render(lab, "soft_shadow_volume", params, &r)) return f;
     RefInfo info;
-    RefRequest rq = {0, {MEASURE_VISIBILITY, REF_SAMPLES, SAMPLING_STRATIFIED, 1}, NULL};
+    RefRequest rq = {0, {MEASURE_VISIBILITY, REF_SAMPLES, SAMPLING_STRATIFIED, 1, false}, NULL};
     const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
     const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
     if (ref && cls && soft_metrics(lab, &r.visibility, REF_SAMPLES, &m)) {
@@ -178,7 +178,7 @@ static Pop popping(const char *tech, const char *const *params)
     for (int k = 0; ok && k < 2; k++) {
         Error err;
         RefInfo info;
-        RefRequest rq = {0, {MEASURE_VISIBILITY, REF_SAMPLES, SAMPLING_STRATIFIED, 1}, NULL};
+        RefRequest rq = {0, {MEASURE_VISIBILITY, REF_SAMPLES, SAMPLING_STRATIFIED, 1, false}, NULL};
         ok = soft_render(lab[k], tech, params, &r[k]);
         ref[k] = ok ? res_reference(lab_resources(lab[k]), lab_scene(lab[k]), &rq, &info, &err) : NULL;
         cls[k] = ok ? res_classes(lab_resources(lab[k]), lab_scene(lab[k]), 0, &err) : NULL;

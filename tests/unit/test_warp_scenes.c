@@ -41,7 +41,7 @@ static long misclassified(Lab *lab, const char *const *assign, int n)
     Error err;
     const Technique *t = tech_find("sm", &err);
     CompareRequest rq = {.tech = t, .light_index = 0, .repeat = 1, .reference = true,
-                         .ref = {MEASURE_VISIBILITY, 1, SAMPLING_R2, 1}};
+                         .ref = {MEASURE_VISIBILITY, 1, SAMPLING_R2, 1, false}};
     double p[TECH_MAX_PARAMS];
     if (!params_of(t, assign, n, p)) return -1;
     rq.params = p;
