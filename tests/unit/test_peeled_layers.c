@@ -273,7 +273,7 @@ TEST(test_peeled_layers_contour_pops_where_the_outline_changes)
             render_result_free(&r);
         }
         RefInfo info;
-        RefRequest rq = {0, {MEASURE_VISIBILITY, 144, SAMPLING_STRATIFIED, 1}, NULL};
+        RefRequest rq = {0, {MEASURE_VISIBILITY, 144, SAMPLING_STRATIFIED, 1, false}, NULL};
         const Reference *ref = res_reference(lab_resources(lab), lab_scene(lab), &rq, &info, &err);
         const uint8_t *cls = ref ? res_classes(lab_resources(lab), lab_scene(lab), 0, &err) : NULL;
         CHECK_MSG(cls, "%s", err.msg);
