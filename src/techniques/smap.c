@@ -87,23 +87,31 @@ SmapBias smap_bias(const double *p, const Scene *scene)
 
 /* The constant part of the bias (course §2.1.2: world units plus steps of
  * the stored depth) in the stored metric, at a receiver of post-projective
- * depth z_ndc and linear depth depth_linear on a face. A step (the r of
- * glPolygonOffset) is a quantisation level, or a float32 ulp at the
- * receiver; in world units, divided by dz_ndc/d depth on ndc maps. Every
- * operand is computed, then selected, so a loop over receivers runs in
- * lanes; x / 1.0 and x * 1.0 are exact, the same as leaving them out. */
-static inline double constant_bias(const ShadowMap *m, const SmapBias *b, int face, double z_ndc, double depth_linear,
-                                   double ndc_per_world)
+ * depth z_ndc and linear depth depth_linear, on a map storing ndc or linear
+ * depth in `bits` (0: float32) over `depth_range` world units (the face's
+ * far - near). A step (the r of glPolygonOffset) is a quantisation level, or
+ * a float32 ulp at the receiver; on ndc maps it is made world units through
+ * dz_ndc/d depth, then the sum made ndc again. */
+static inline double constant_bias(const SmapBias *b, bool ndc, int bits, double depth_range, double z_ndc,
+                                   double depth_linear, double ndc_per_world)
+{
+    double levels = (double)((1u << bits) - 1u); /* read only where bits > 0 */
+    if (!ndc) return b->constant_world + b->steps * (bits ? depth_range / levels : fabs(depth_linear) * FLT_EPSILON);
+    /* nan_max(|z_ndc|, FLT_MIN) FLT_EPSILON, the scaling first: times 2^-23
+     * is exact in double down to 2^-999, and one compare with the scaled
+     * floor keeps NaN (so the multiply is not moved into a branch) */
+    double ulp = fabs(z_ndc) * FLT_EPSILON, ulp_min = (double)FLT_MIN * FLT_EPSILON;
+    double step_ndc = bits ? 1.0 / levels : ulp < ulp_min ? ulp_min : ulp;
+    return (b->constant_world + b->steps * (step_ndc / ndc_per_world)) * ndc_per_world;
+}
+
+/* The same for a receiver of a map's face. */
+static inline double face_constant_bias(const ShadowMap *m, const SmapBias *b, int face, double z_ndc,
+                                        double depth_linear, double ndc_per_world)
 {
     const RasterView *rv = &m->view.face[face].raster;
-    bool ndc = m->spec.depth == RASTER_DEPTH_NDC;
-    int bits = m->spec.depth_bits;
-    double levels = bits ? (double)((1u << bits) - 1u) : 1.0;
-    double level = (ndc ? 1.0 : rv->depth_far - rv->depth_near) / levels; /* one quantisation level, stored metric */
-    double ulp = (ndc ? nan_max(fabs(z_ndc), FLT_MIN) : fabs(depth_linear)) * FLT_EPSILON;
-    double to_stored = ndc ? ndc_per_world : 1.0;
-    double step_world = (bits ? level : ulp) / to_stored;
-    return (b->constant_world + b->steps * step_world) * to_stored;
+    return constant_bias(b, m->spec.depth == RASTER_DEPTH_NDC, m->spec.depth_bits, rv->depth_far - rv->depth_near,
+                         z_ndc, depth_linear, ndc_per_world);
 }
 
 static inline double stored_depth(const ShadowMap *m, double z_ndc, double depth_linear)
@@ -169,7 +177,7 @@ static bool receiver_bias(const ShadowMap *m, const SmapBias *b, dvec3 p, dvec3 
     double reach = 1.0 + b->filter_radius;
     double slope_max = b->slope_max_texels * r->texel_world * to_stored * reach;
     double slope = plane ? nan_min(b->slope * depth_slope(r) * reach, slope_max) : b->slope > 0.0 ? slope_max : 0.0;
-    r->bias = constant_bias(m, b, r->mc.face, r->mc.z_ndc, r->mc.depth_linear, ndc_per_world) + slope;
+    r->bias = face_constant_bias(m, b, r->mc.face, r->mc.z_ndc, r->mc.depth_linear, ndc_per_world) + slope;
     r->ref = stored_depth(m, r->mc.z_ndc, r->mc.depth_linear) - r->bias;
     r->plane = plane && b->receiver_plane;
     return true;
@@ -363,18 +371,32 @@ bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_g
 /* receiver_bias without a plane (slope_bias 0): the reference depths of a
  * located batch in double lanes, in receiver_bias's order of operations
  * (its slope term is then 0.0), so every reference is the same double. */
-static void refs_float(const ShadowMap *m, const SmapBias *b, const BatchF *B, int n, SmapRefs *o)
+__attribute__((always_inline)) static inline void refs_lanes(const SmapBias *b, bool ndc, int bits,
+                                                             double depth_range, const BatchF *B, int n, SmapRefs *o)
 {
 #pragma omp simd
     for (int k = 0; k < n; k++) {
         double z_ndc = B->z_ndc[k], depth = B->depth[k];
-        double bias = constant_bias(m, b, 0, z_ndc, depth, B->ndc_per_world[k]) + 0.0;
-        o->ref_up[k] = smap_ref_up(stored_depth(m, z_ndc, depth) - bias);
+        double bias = constant_bias(b, ndc, bits, depth_range, z_ndc, depth, B->ndc_per_world[k]) + 0.0;
+        o->ref_up[k] = smap_ref_up((ndc ? z_ndc : depth) - bias);
         o->s[k] = B->s[k];
         o->t[k] = B->t[k];
         o->face[k] = 0;
         o->inside[k] = B->inside[k] != 0;
     }
+}
+
+/* refs_lanes with the float32 formats' choices made before the loop, so
+ * their loops run without branches (and in vector lanes where they can). */
+static void refs_float(const ShadowMap *m, const SmapBias *b, const BatchF *B, int n, SmapRefs *o)
+{
+    const RasterView *rv = &m->view.face[0].raster;
+    bool ndc = m->spec.depth == RASTER_DEPTH_NDC;
+    int bits = m->spec.depth_bits;
+    double range = rv->depth_far - rv->depth_near;
+    if (bits) refs_lanes(b, ndc, bits, range, B, n, o);
+    else if (ndc) refs_lanes(b, true, 0, range, B, n, o);
+    else refs_lanes(b, false, 0, range, B, n, o);
 }
 
 void smap_refs(const ShadowMap *m, const SmapBias *b, const vec3 *p_world, const vec3 *n_geom_world,

@@ -3,7 +3,9 @@
  * and without the normal offset, it locates each lit candidate where the
  * double-precision lookup (lightview_locate, lightview_texel_world) does, to
  * float32 rounding; a sample gets the same receiver whatever its place in a
- * batch (smap_receiver is a batch of one); other classes are left out. */
+ * batch (smap_receiver is a batch of one); other classes are left out.
+ * smap_refs gives pcf the same references to the bit, and pcf's vector box
+ * counts as its taps one by one, past the map's edges too. */
 #include <float.h>
 #include <stdlib.h>
 #include <string.h>
