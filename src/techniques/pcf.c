@@ -116,15 +116,6 @@ static inline int floor_int(double x)
     return i - (x < i);
 }
 
-/* Four taps of a row against the reference: per lane `lit` where
- * ref <= z, `shadowed` where ref > z, 0 where either is NaN. */
-static inline i32x4 taps4(f32x4 ref, const float *row, i32x4 lit, i32x4 shadowed)
-{
-    f32x4 z;
-    memcpy(&z, row, sizeof z);
-    return ((ref <= z) & lit) + ((ref > z) & shadowed);
-}
-
 /* The K x K window of a face from texel (i0, j0), rows `width` >= K taps
  * wide, where it reaches past the map's edges: clamped to them, as
  * shadowmap_texel reads (row j of the window at window + j * width). */
@@ -137,16 +128,44 @@ static void edge_window(const ShadowMap *m, int face, int i0, int j0, int K, int
     }
 }
 
+/* A box's taps counted in int32 lanes: -1 per lit tap, and -1 wherever a
+ * depth was NaN (neither lit nor shadowed). */
+typedef struct BoxCount {
+    i32x4 lit, nan;
+} BoxCount;
+
+/* The K rows of a box, `stride` floats apart, against the reference in
+ * every lane: 4 taps to a vector, `width` (K rounded up to vectors) read
+ * per row, the lanes of the last vector past K masked off (`last`). Inlined
+ * with a constant width, each row's loop unrolls. */
+__attribute__((always_inline)) static inline BoxCount box_rows(const float *row, ptrdiff_t stride, int K, int width,
+                                                               f32x4 ref, i32x4 last)
+{
+    BoxCount c = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+    for (int j = 0; j < K; j++, row += stride) {
+        f32x4 z;
+        int i = 0;
+#pragma GCC unroll 4
+        for (; i < width - 4; i += 4) {
+            memcpy(&z, row + i, sizeof z);
+            c.lit += ref <= z;
+            c.nan |= z != z;
+        }
+        memcpy(&z, row + i, sizeof z);
+        c.lit += (ref <= z) & last;
+        c.nan |= (z != z) & last;
+    }
+    return c;
+}
+
 /* Lit taps of the K x K box from texel (i0, j0) of a face against one
  * reference depth, rounded up to float32 (smap_ref_up: every outcome that
  * of smap_test's double compare); NaN if a tap (or the reference) is NaN,
- * which is neither lit nor shadowed. Each row is read 4 taps to a vector,
- * the last vector masked to K; lit taps count 1 and shadowed ones 1 << 16
- * in int32 lanes (K^2 < 2^16: the counts never mix), added up once. A box
- * past the map's edges reads a clamped copy (edge_window) in the same loop. */
+ * which is neither lit nor shadowed. A box past the map's edges reads a
+ * clamped copy (edge_window) in the same loop; boxes up to 16 wide take
+ * their width's unrolled loop. */
 static float box_lit(const ShadowMap *m, int face, int i0, int j0, int K, float ref)
 {
-    _Static_assert(PCF_MAX_K * PCF_MAX_K < 1 << 16, "a box's lit and shadowed counts share a lane");
     int res = m->res, width = (K + 3) & ~3; /* taps read per row: K rounded up to vectors */
     float window[PCF_MAX_K * (PCF_MAX_K + 3)];
     const float *row = window;
@@ -158,16 +177,13 @@ static float box_lit(const ShadowMap *m, int face, int i0, int j0, int K, float 
         edge_window(m, face, i0, j0, K, width, window);
     }
     f32x4 r = {ref, ref, ref, ref};
-    i32x4 lit = {1, 1, 1, 1}, shadowed = lit << 16, lane = {0, 1, 2, 3};
-    i32x4 last = lane < K - (width - 4); /* the lanes of a row's last vector inside K */
-    i32x4 last_lit = lit & last, last_shadowed = shadowed & last, count = {0, 0, 0, 0};
-    for (int j = 0; j < K; j++, row += stride) {
-        int i = 0;
-        for (; i < width - 4; i += 4) count += taps4(r, row + i, lit, shadowed);
-        count += taps4(r, row + i, last_lit, last_shadowed);
-    }
-    int sum = count[0] + count[1] + count[2] + count[3], n_lit = sum & 0xffff, n_shadowed = sum >> 16;
-    return n_lit + n_shadowed == K * K ? (float)n_lit : NAN;
+    i32x4 lane = {0, 1, 2, 3}, last = lane < K - (width - 4); /* the lanes of a row's last vector inside K */
+    BoxCount c = width == 4    ? box_rows(row, stride, K, 4, r, last)
+                 : width == 8  ? box_rows(row, stride, K, 8, r, last)
+                 : width == 16 ? box_rows(row, stride, K, 16, r, last)
+                               : box_rows(row, stride, K, width, r, last);
+    int lit = -(c.lit[0] + c.lit[1] + c.lit[2] + c.lit[3]);
+    return ref != ref || (c.nan[0] | c.nan[1] | c.nan[2] | c.nan[3]) ? NAN : (float)lit;
 }
 
 /* Box: K x K texel centres around (s, t); the first is at floor(s - K/2 + 1/2). */
