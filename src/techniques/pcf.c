@@ -182,8 +182,10 @@ static float box_lit(const ShadowMap *m, int face, int i0, int j0, int K, float 
                  : width == 8  ? box_rows(row, stride, K, 8, r, last)
                  : width == 16 ? box_rows(row, stride, K, 16, r, last)
                                : box_rows(row, stride, K, width, r, last);
-    int lit = -(c.lit[0] + c.lit[1] + c.lit[2] + c.lit[3]);
-    return ref != ref || (c.nan[0] | c.nan[1] | c.nan[2] | c.nan[3]) ? NAN : (float)lit;
+    /* one sum for both: -(lit taps) <= 0 plus 2^20 > K^2 per lane that saw a NaN */
+    i32x4 sum = c.lit + (c.nan & (1 << 20));
+    int total = sum[0] + sum[1] + sum[2] + sum[3];
+    return ref != ref || total > 0 ? NAN : (float)-total;
 }
 
 /* Box: K x K texel centres around (s, t); the first is at floor(s - K/2 + 1/2). */
