@@ -5,7 +5,10 @@
  * weights at its rim); a Poisson disk of diameter K texels, rotated per
  * pixel; and adaptive PCF (Uralsky 2005, course §4.2): the first taps of
  * the disk, and all of them only where those disagree (the penumbra). */
+#include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 #include "core/hash.h"
 #include "resources/standard.h"
 #include "techniques/smap.h"
@@ -100,43 +103,101 @@ static bool pcf_prepare(const TechContext *ctx, void **state, Error *err)
     return true;
 }
 
-/* Lit taps of row j (clamped to the edge, like shadowmap_texel) over
- * columns [i0, i0 + K) against one reference depth, rounded up to float32
- * (smap_ref_up: the same outcomes as smap_test's double compare): smap_test
- * with the row addressed once and no per-tap branch, in float lanes, so the
- * interior loop vectorises. Lit and shadowed taps are counted apart: a NaN
- * texel (or reference) is neither, and makes the row NaN. */
-static float box_row_lit(const ShadowMap *m, int face, int i0, int j, int K, float ref)
+/* Four float32 and four int32 lanes (GCC's and clang's vector extension:
+ * SSE2 on x86-64, NEON on arm64); a compare gives -1 (true) or 0 per lane. */
+typedef float f32x4 __attribute__((vector_size(16)));
+typedef int32_t i32x4 __attribute__((vector_size(16)));
+
+/* (int)floor(x) for x well inside int's range (texel coordinates): the
+ * truncation, one less where it rounded a negative x up. */
+static inline int floor_int(double x)
 {
-    int res = m->res, lit = 0, shadowed = 0;
-    const float *row = shadowmap_row(m, face, j, K); /* counts the K taps (core/counters.h) */
-    if (i0 >= 0 && i0 + K <= res) {
-        for (int i = i0; i < i0 + K; i++) {
-            lit += ref <= row[i];
-            shadowed += ref > row[i];
-        }
-    } else {
-        for (int i = i0; i < i0 + K; i++) {
-            float z = row[i < 0 ? 0 : i >= res ? res - 1 : i];
-            lit += ref <= z;
-            shadowed += ref > z;
-        }
+    int i = (int)x;
+    return i - (x < i);
+}
+
+/* The K x K window of a face from texel (i0, j0), rows `width` >= K taps
+ * wide, where it reaches past the map's edges: clamped to them, as
+ * shadowmap_texel reads (row j of the window at window + j * width). */
+static void edge_window(const ShadowMap *m, int face, int i0, int j0, int K, int width, float *window)
+{
+    int res = m->res;
+    for (int j = 0; j < K; j++) {
+        const float *row = shadowmap_row(m, face, j0 + j, K); /* clamps the row; counts its K taps */
+        for (int i = 0; i < width; i++) window[j * width + i] = row[i0 + i < 0 ? 0 : i0 + i >= res ? res - 1 : i0 + i];
     }
-    return lit + shadowed == K ? (float)lit : NAN;
+}
+
+/* A box's taps counted in int32 lanes: -1 per lit tap, and -1 wherever a
+ * depth was NaN (neither lit nor shadowed). */
+typedef struct BoxCount {
+    i32x4 lit, nan;
+} BoxCount;
+
+/* The K rows of a box, `stride` floats apart, against the reference in
+ * every lane: 4 taps to a vector, `width` (K rounded up to vectors) read
+ * per row, the lanes of the last vector past K masked off (`last`). Inlined
+ * with a constant width, each row's loop unrolls. */
+__attribute__((always_inline)) static inline BoxCount box_rows(const float *row, ptrdiff_t stride, int K, int width,
+                                                               f32x4 ref, i32x4 last)
+{
+    BoxCount c = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+    for (int j = 0; j < K; j++, row += stride) {
+        f32x4 z;
+        int i = 0;
+#pragma GCC unroll 4
+        for (; i < width - 4; i += 4) {
+            memcpy(&z, row + i, sizeof z);
+            c.lit += ref <= z;
+            c.nan |= z != z;
+        }
+        memcpy(&z, row + i, sizeof z);
+        c.lit += (ref <= z) & last;
+        c.nan |= (z != z) & last;
+    }
+    return c;
+}
+
+/* Lit taps of the K x K box from texel (i0, j0) of a face against one
+ * reference depth, rounded up to float32 (smap_ref_up: every outcome that
+ * of smap_test's double compare); NaN if a tap (or the reference) is NaN,
+ * which is neither lit nor shadowed. A box past the map's edges reads a
+ * clamped copy (edge_window) in the same loop; boxes up to 16 wide take
+ * their width's unrolled loop. */
+static float box_lit(const ShadowMap *m, int face, int i0, int j0, int K, float ref)
+{
+    int res = m->res, width = (K + 3) & ~3; /* taps read per row: K rounded up to vectors */
+    float window[PCF_MAX_K * (PCF_MAX_K + 3)];
+    const float *row = window;
+    ptrdiff_t stride = width;
+    if (i0 >= 0 && i0 + width <= res && j0 >= 0 && j0 + K <= res) {
+        row = shadowmap_row(m, face, j0, K * K) + i0; /* counts the K^2 taps (core/counters.h) */
+        stride = res;
+    } else {
+        edge_window(m, face, i0, j0, K, width, window);
+    }
+    f32x4 r = {ref, ref, ref, ref};
+    i32x4 lane = {0, 1, 2, 3}, last = lane < K - (width - 4); /* the lanes of a row's last vector inside K */
+    BoxCount c = width == 4    ? box_rows(row, stride, K, 4, r, last)
+                 : width == 8  ? box_rows(row, stride, K, 8, r, last)
+                 : width == 16 ? box_rows(row, stride, K, 16, r, last)
+                               : box_rows(row, stride, K, width, r, last);
+    /* one sum for both: -(lit taps) <= 0 plus 2^20 > K^2 per lane that saw a NaN */
+    i32x4 sum = c.lit + (c.nan & (1 << 20));
+    int total = sum[0] + sum[1] + sum[2] + sum[3];
+    return ref != ref || total > 0 ? NAN : (float)-total;
 }
 
 /* Box: K x K texel centres around (s, t); the first is at floor(s - K/2 + 1/2). */
-static float filter_box(const PcfState *st, const SmapReceiver *r)
+static int box_first(double s, int K) { return floor_int(s - 0.5 * K + 0.5); }
+
+/* The box with the receiver plane: a reference per texel. */
+static float filter_box_plane(const PcfState *st, const SmapReceiver *r)
 {
-    int i0 = (int)floor(r->mc.s - 0.5 * st->K + 0.5), j0 = (int)floor(r->mc.t - 0.5 * st->K + 0.5);
+    int i0 = box_first(r->mc.s, st->K), j0 = box_first(r->mc.t, st->K);
     float lit = 0.0f;
-    if (r->plane) { /* a reference per texel (receiver-plane bias) */
-        for (int j = j0; j < j0 + st->K; j++)
-            for (int i = i0; i < i0 + st->K; i++) lit += smap_lit(st->map, r, i, j);
-    } else {
-        float ref = smap_ref_up(r->ref);
-        for (int j = j0; j < j0 + st->K; j++) lit += box_row_lit(st->map, r->mc.face, i0, j, st->K, ref);
-    }
+    for (int j = j0; j < j0 + st->K; j++)
+        for (int i = i0; i < i0 + st->K; i++) lit += smap_lit(st->map, r, i, j);
     return lit / (float)(st->K * st->K);
 }
 
@@ -185,19 +246,39 @@ static float filter_disk(const PcfState *st, const SmapReceiver *r, uint32_t sam
 static float pcf_filter(const PcfState *st, const SmapReceiver *r, int sample)
 {
     switch (st->kernel) {
-    case KERNEL_BOX: return filter_box(st, r);
+    case KERNEL_BOX: return filter_box_plane(st, r);
     case KERNEL_BILINEAR: return filter_bilinear(st, r);
     default: return filter_disk(st, r, (uint32_t)sample);
     }
 }
 
-/* Receivers are set up SMAP_BATCH samples at a time (smap_receivers), then
- * filtered one by one. */
+/* The box without the receiver plane: one reference per sample, read from
+ * the batch's arrays (smap_refs). */
+static void evaluate_box(const PcfState *st, const TechContext *ctx, int first, int n, int begin, float *out)
+{
+    SmapRefs r;
+    smap_refs(st->map, &st->bias, ctx->vs->p_world + first, ctx->vs->n_geom_world + first, ctx->cls + first, n, &r);
+    float area = (float)(st->K * st->K);
+    for (int k = 0; k < r.count; k++) {
+        float v = 1.0f;
+        if (r.inside[k])
+            v = box_lit(st->map, r.face[k], box_first(r.s[k], st->K), box_first(r.t[k], st->K), st->K, r.ref_up[k]) /
+                area;
+        tech_store(ctx, out, begin, first + r.sample[k], v);
+    }
+}
+
+/* Receivers are set up SMAP_BATCH samples at a time (smap_refs for the box
+ * without the receiver plane, else smap_receivers), then filtered one by one. */
 static void pcf_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
 {
     const PcfState *st = state;
     for (int first = begin; first < end; first += SMAP_BATCH) {
         int n = end - first < SMAP_BATCH ? end - first : SMAP_BATCH;
+        if (st->kernel == KERNEL_BOX && !st->bias.receiver_plane) {
+            evaluate_box(st, ctx, first, n, begin, out);
+            continue;
+        }
         SmapReceiver r[SMAP_BATCH];
         bool inside[SMAP_BATCH];
         smap_receivers(st->map, &st->bias, ctx->vs->p_world + first, ctx->vs->n_geom_world + first, ctx->cls + first,

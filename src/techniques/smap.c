@@ -85,22 +85,38 @@ SmapBias smap_bias(const double *p, const Scene *scene)
     return b;
 }
 
-/* World size of one step of the stored depth at the receiver (the r of
- * glPolygonOffset): a quantisation level, or a float32 ulp. */
-static double depth_step_world(const ShadowMap *m, const MapCoord *mc, double ndc_per_world)
+/* The constant part of the bias (course §2.1.2: world units plus steps of
+ * the stored depth) in the stored metric, at a receiver of post-projective
+ * depth z_ndc and linear depth depth_linear, on a map storing ndc or linear
+ * depth in `bits` (0: float32) over `depth_range` world units (the face's
+ * far - near). A step (the r of glPolygonOffset) is a quantisation level, or
+ * a float32 ulp at the receiver; on ndc maps it is made world units through
+ * dz_ndc/d depth, then the sum made ndc again. */
+static inline double constant_bias(const SmapBias *b, bool ndc, int bits, double depth_range, double z_ndc,
+                                   double depth_linear, double ndc_per_world)
 {
-    const RasterView *rv = &m->view.face[mc->face].raster;
-    int bits = m->spec.depth_bits;
-    if (m->spec.depth == RASTER_DEPTH_LINEAR)
-        return bits ? (rv->depth_far - rv->depth_near) / (double)((1u << bits) - 1u)
-                    : fabs(mc->depth_linear) * FLT_EPSILON;
-    double step_ndc = bits ? 1.0 / (double)((1u << bits) - 1u) : nan_max(fabs(mc->z_ndc), FLT_MIN) * FLT_EPSILON;
-    return step_ndc / ndc_per_world;
+    double levels = (double)((1u << bits) - 1u); /* read only where bits > 0 */
+    if (!ndc) return b->constant_world + b->steps * (bits ? depth_range / levels : fabs(depth_linear) * FLT_EPSILON);
+    /* nan_max(|z_ndc|, FLT_MIN) FLT_EPSILON, the scaling first: times 2^-23
+     * is exact in double down to 2^-999, and one compare with the scaled
+     * floor keeps NaN (so the multiply is not moved into a branch) */
+    double ulp = fabs(z_ndc) * FLT_EPSILON, ulp_min = (double)FLT_MIN * FLT_EPSILON;
+    double step_ndc = bits ? 1.0 / levels : ulp < ulp_min ? ulp_min : ulp;
+    return (b->constant_world + b->steps * (step_ndc / ndc_per_world)) * ndc_per_world;
 }
 
-static double stored_depth(const ShadowMap *m, const MapCoord *mc)
+/* The same for a receiver of a map's face. */
+static inline double face_constant_bias(const ShadowMap *m, const SmapBias *b, int face, double z_ndc,
+                                        double depth_linear, double ndc_per_world)
 {
-    return m->spec.depth == RASTER_DEPTH_NDC ? mc->z_ndc : mc->depth_linear;
+    const RasterView *rv = &m->view.face[face].raster;
+    return constant_bias(b, m->spec.depth == RASTER_DEPTH_NDC, m->spec.depth_bits, rv->depth_far - rv->depth_near,
+                         z_ndc, depth_linear, ndc_per_world);
+}
+
+static inline double stored_depth(const ShadowMap *m, double z_ndc, double depth_linear)
+{
+    return m->spec.depth == RASTER_DEPTH_NDC ? z_ndc : depth_linear;
 }
 
 /* The receiver's plane (point q, normal n) seen through texel coordinates
@@ -113,7 +129,7 @@ static bool plane_metric(const ShadowMap *m, const SmapReceiver *r, dvec3 q, dve
     if (!(fabs(dn) > 1e-9)) return false; /* the ray runs along the plane: grazing light */
     dvec3 x = d3_madd(org, dir, d3_dot(d3_sub(q, org), n) / dn);
     MapCoord c = lightview_locate_on(&m->view, r->mc.face, x);
-    double v = stored_depth(m, &c);
+    double v = stored_depth(m, c.z_ndc, c.depth_linear);
     if (r->reciprocal && !(v > 0.0)) return false;
     *g = r->reciprocal ? 1.0 / v : v;
     return isfinite(*g);
@@ -161,9 +177,8 @@ static bool receiver_bias(const ShadowMap *m, const SmapBias *b, dvec3 p, dvec3 
     double reach = 1.0 + b->filter_radius;
     double slope_max = b->slope_max_texels * r->texel_world * to_stored * reach;
     double slope = plane ? nan_min(b->slope * depth_slope(r) * reach, slope_max) : b->slope > 0.0 ? slope_max : 0.0;
-    double constant = (b->constant_world + b->steps * depth_step_world(m, &r->mc, ndc_per_world)) * to_stored;
-    r->bias = constant + slope;
-    r->ref = stored_depth(m, &r->mc) - r->bias;
+    r->bias = face_constant_bias(m, b, r->mc.face, r->mc.z_ndc, r->mc.depth_linear, ndc_per_world) + slope;
+    r->ref = stored_depth(m, r->mc.z_ndc, r->mc.depth_linear) - r->bias;
     r->plane = plane && b->receiver_plane;
     return true;
 }
@@ -275,33 +290,40 @@ static void locate_batch(const FaceF *f, int n, BatchF *b)
     }
 }
 
-/* Samples [0, n) of a batch on a FaceF map: lift by rt_ray_offset, locate,
- * normal offset, locate again, then the biases per receiver. */
+/* Samples index[0, n) of the arrays on a FaceF map: lift by rt_ray_offset,
+ * locate, normal offset, locate again. */
+static void batch_locate(const FaceF *f, const SmapBias *b, const vec3 *p_world, const vec3 *n_geom_world,
+                         const int *index, int n, BatchF *B)
+{
+    for (int k = 0; k < n; k++) {
+        vec3 p = p_world[index[k]], nrm = n_geom_world[index[k]];
+        float lift = rt_ray_offset(b->scene_extent, p);
+        B->nx[k] = nrm.x;
+        B->ny[k] = nrm.y;
+        B->nz[k] = nrm.z;
+        B->x[k] = p.x + nrm.x * lift;
+        B->y[k] = p.y + nrm.y * lift;
+        B->z[k] = p.z + nrm.z * lift;
+    }
+    locate_batch(f, n, B);
+    if (b->normal_offset_texels > 0.0) {
+        float off = (float)b->normal_offset_texels;
+        for (int k = 0; k < n; k++) {
+            float step = off * B->texel_world[k];
+            B->x[k] += B->nx[k] * step;
+            B->y[k] += B->ny[k] * step;
+            B->z[k] += B->nz[k] * step;
+        }
+        locate_batch(f, n, B);
+    }
+}
+
+/* The same, then the biases per receiver. */
 static void receivers_float(const ShadowMap *m, const FaceF *f, const SmapBias *b, const vec3 *p_world,
                             const vec3 *n_geom_world, const int *index, int n, SmapReceiver *r, bool *inside)
 {
     BatchF B;
-    for (int k = 0; k < n; k++) {
-        vec3 p = p_world[index[k]], nrm = n_geom_world[index[k]];
-        float lift = rt_ray_offset(b->scene_extent, p);
-        B.nx[k] = nrm.x;
-        B.ny[k] = nrm.y;
-        B.nz[k] = nrm.z;
-        B.x[k] = p.x + nrm.x * lift;
-        B.y[k] = p.y + nrm.y * lift;
-        B.z[k] = p.z + nrm.z * lift;
-    }
-    locate_batch(f, n, &B);
-    if (b->normal_offset_texels > 0.0) {
-        float off = (float)b->normal_offset_texels;
-        for (int k = 0; k < n; k++) {
-            float step = off * B.texel_world[k];
-            B.x[k] += B.nx[k] * step;
-            B.y[k] += B.ny[k] * step;
-            B.z[k] += B.nz[k] * step;
-        }
-        locate_batch(f, n, &B);
-    }
+    batch_locate(f, b, p_world, n_geom_world, index, n, &B);
     for (int k = 0; k < n; k++) {
         SmapReceiver *o = &r[index[k]];
         o->mc = (MapCoord){.face = 0, .s = B.s[k], .t = B.t[k], .depth_linear = B.depth[k], .z_ndc = B.z_ndc[k],
@@ -312,17 +334,24 @@ static void receivers_float(const ShadowMap *m, const FaceF *f, const SmapBias *
     }
 }
 
+/* The lit candidates among samples [first, min(count, first + SMAP_BATCH))
+ * (cls NULL: all), into index; their number. */
+static int batch_candidates(const uint8_t *cls, int first, int count, int *index)
+{
+    int n = 0;
+    for (int i = first; i < count && i < first + SMAP_BATCH; i++)
+        if (!cls || cls[i] == SAMPLE_LIT_CANDIDATE) index[n++] = i;
+    return n;
+}
+
 void smap_receivers(const ShadowMap *m, const SmapBias *b, const vec3 *p_world, const vec3 *n_geom_world,
                     const uint8_t *cls, int count, SmapReceiver *r, bool *inside)
 {
     FaceF f;
     bool batched = face_float(m, &f);
+    for (int i = 0; i < count; i++) inside[i] = false;
     for (int first = 0; first < count; first += SMAP_BATCH) {
-        int index[SMAP_BATCH], n = 0;
-        for (int i = first; i < count && i < first + SMAP_BATCH; i++) {
-            inside[i] = false;
-            if (!cls || cls[i] == SAMPLE_LIT_CANDIDATE) index[n++] = i;
-        }
+        int index[SMAP_BATCH], n = batch_candidates(cls, first, count, index);
         if (batched) {
             receivers_float(m, &f, b, p_world, n_geom_world, index, n, r, inside);
             continue;
@@ -337,4 +366,60 @@ bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_g
     bool inside;
     smap_receivers(m, b, &p_world, &n_geom_world, NULL, 1, r, &inside);
     return inside;
+}
+
+/* receiver_bias without a plane (slope_bias 0): the reference depths of a
+ * located batch in double lanes, in receiver_bias's order of operations
+ * (its slope term is then 0.0), so every reference is the same double. */
+__attribute__((always_inline)) static inline void refs_lanes(const SmapBias *b, bool ndc, int bits,
+                                                             double depth_range, const BatchF *B, int n, SmapRefs *o)
+{
+#pragma omp simd
+    for (int k = 0; k < n; k++) {
+        double z_ndc = B->z_ndc[k], depth = B->depth[k];
+        double bias = constant_bias(b, ndc, bits, depth_range, z_ndc, depth, B->ndc_per_world[k]) + 0.0;
+        o->ref_up[k] = smap_ref_up((ndc ? z_ndc : depth) - bias);
+        o->s[k] = B->s[k];
+        o->t[k] = B->t[k];
+        o->face[k] = 0;
+        o->inside[k] = B->inside[k] != 0;
+    }
+}
+
+/* refs_lanes with the float32 formats' choices made before the loop, so
+ * their loops run without branches (and in vector lanes where they can). */
+static void refs_float(const ShadowMap *m, const SmapBias *b, const BatchF *B, int n, SmapRefs *o)
+{
+    const RasterView *rv = &m->view.face[0].raster;
+    bool ndc = m->spec.depth == RASTER_DEPTH_NDC;
+    int bits = m->spec.depth_bits;
+    double range = rv->depth_far - rv->depth_near;
+    if (bits) refs_lanes(b, ndc, bits, range, B, n, o);
+    else if (ndc) refs_lanes(b, true, 0, range, B, n, o);
+    else refs_lanes(b, false, 0, range, B, n, o);
+}
+
+void smap_refs(const ShadowMap *m, const SmapBias *b, const vec3 *p_world, const vec3 *n_geom_world,
+               const uint8_t *cls, int count, SmapRefs *out)
+{
+    FaceF f;
+    out->count = batch_candidates(cls, 0, count, out->sample);
+    if (!(b->slope > 0.0) && face_float(m, &f)) {
+        BatchF B;
+        batch_locate(&f, b, p_world, n_geom_world, out->sample, out->count, &B);
+        refs_float(m, b, &B, out->count, out);
+        return;
+    }
+    SmapReceiver r[SMAP_BATCH];
+    bool inside[SMAP_BATCH];
+    smap_receivers(m, b, p_world, n_geom_world, cls, count, r, inside);
+    for (int k = 0; k < out->count; k++) {
+        const SmapReceiver *o = &r[out->sample[k]];
+        out->inside[k] = inside[out->sample[k]];
+        if (!out->inside[k]) continue;
+        out->face[k] = o->mc.face;
+        out->s[k] = o->mc.s;
+        out->t[k] = o->mc.t;
+        out->ref_up[k] = smap_ref_up(o->ref);
+    }
 }

@@ -10,6 +10,7 @@
  * at SMAP_NUM_DEPTH_BIAS_PARAMS). */
 #ifndef SL_SMAP_H
 #define SL_SMAP_H
+#include <string.h>
 #include "core/nanmath.h"
 #include "resources/shadowmap.h"
 #include "techniques/technique.h"
@@ -201,6 +202,25 @@ bool smap_receiver(const ShadowMap *m, const SmapBias *b, vec3 p_world, vec3 n_g
 void smap_receivers(const ShadowMap *m, const SmapBias *b, const vec3 *p_world, const vec3 *n_geom_world,
                     const uint8_t *cls, int count, SmapReceiver *r, bool *inside);
 
+/* A batch's receivers as a filter that compares every tap with its
+ * sample's one reference depth reads them (no receiver plane): one array per
+ * quantity, written once per batch. */
+typedef struct SmapRefs {
+    int count;                            /* lit candidates of the batch, in sample order */
+    int sample[SMAP_BATCH];               /* each one's index in the batch */
+    bool inside[SMAP_BATCH];              /* smap_receiver's answer; the rest is unset where false */
+    int face[SMAP_BATCH];                 /* the map face it falls on */
+    double s[SMAP_BATCH], t[SMAP_BATCH];  /* texel coordinates of the lookup point on that face */
+    float ref_up[SMAP_BATCH];             /* smap_ref_up of the biased reference depth */
+} SmapRefs;
+/* smap_receivers' set-up of samples [0, count <= SMAP_BATCH) for a bias
+ * without the receiver plane (b->receiver_plane false), the same reference
+ * depths to the bit. Where the batch path serves and no slope-scaled bias
+ * asks for the receiver's plane, the biases too run in lanes (double, in
+ * receiver_bias's order of operations); else through SmapReceiver records. */
+void smap_refs(const ShadowMap *m, const SmapBias *b, const vec3 *p_world, const vec3 *n_geom_world,
+               const uint8_t *cls, int count, SmapRefs *out);
+
 /* Reference depth at map point (s, t) of the receiver's face (texel units:
  * texel i covers [i, i + 1]): the receiver plane's there, else r->ref. */
 static inline double smap_ref_at_point(const SmapReceiver *r, double s, double t)
@@ -232,7 +252,16 @@ static inline float smap_test(double ref, double stored)
 static inline float smap_ref_up(double ref)
 {
     float f = (float)ref;
-    return (double)f < ref ? nextafterf(f, INFINITY) : f;
+    /* the next float32 up, as nextafterf(f, INFINITY) but inline (it runs in
+     * lanes): f < ref is finite or -inf, never -0 (a ref that rounds to -0
+     * is <= -0), and IEEE 754 orders floats as sign-magnitude integers, so
+     * one step up is magnitude + 1 from +0 up, magnitude - 1 below 0. */
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    u = f >= 0.0f ? u + 1u : u - 1u;
+    float up;
+    memcpy(&up, &u, sizeof up);
+    return (double)f < ref ? up : f;
 }
 
 static inline float smap_lit(const ShadowMap *m, const SmapReceiver *r, int i, int j)

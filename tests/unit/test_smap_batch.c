@@ -3,8 +3,12 @@
  * and without the normal offset, it locates each lit candidate where the
  * double-precision lookup (lightview_locate, lightview_texel_world) does, to
  * float32 rounding; a sample gets the same receiver whatever its place in a
- * batch (smap_receiver is a batch of one); other classes are left out. */
+ * batch (smap_receiver is a batch of one); other classes are left out.
+ * smap_refs gives pcf the same references to the bit, and pcf's vector box
+ * counts as its taps one by one, past the map's edges too. */
+#include <float.h>
 #include <stdlib.h>
+#include <string.h>
 #include "filtered_fixtures.h"
 #include "rt/rt.h"
 #include "techniques/smap.h"
@@ -114,10 +118,139 @@ TEST(test_smap_ref_up_compares_as_the_double_reference)
     for (int k = 0; k < 100000; k++) {
         state = state * 1664525u + 1013904223u;
         double ref = (state >> 8) / 16777216.0 + ldexp((double)(state & 0xff), -40); /* [0, 1), sub-float bits */
+        ref = k % 2 ? -ref : ref;                                                        /* and (-1, 0] */
         float z0 = (float)ref, zs[3] = {nextafterf(z0, -INFINITY), z0, nextafterf(z0, INFINITY)};
+        float up = (double)z0 < ref ? nextafterf(z0, INFINITY) : z0;
+        differing += memcmp(&up, &(float){smap_ref_up(ref)}, sizeof up) != 0;
         for (int i = 0; i < 3; i++, tried++)
             differing += (ref <= zs[i]) != (smap_ref_up(ref) <= zs[i]) || (ref > zs[i]) != (smap_ref_up(ref) > zs[i]);
     }
     CHECK_MSG(differing == 0, "%ld of %ld float compares differ from the double compare", differing, tried);
     CHECK_MSG(isnan(smap_ref_up(NAN)), "NaN reference became a value");
+    CHECK_MSG(smap_ref_up(-INFINITY) == -INFINITY && smap_ref_up(-1e300) == -FLT_MAX && smap_ref_up(1e-300) > 0.0f,
+              "smap_ref_up at the ends of float's range: %g %g %g", smap_ref_up(-INFINITY), smap_ref_up(-1e300),
+              smap_ref_up(1e-300));
+}
+
+/* smap_refs against smap_receivers on every lit candidate: the same
+ * inside answer, texel coordinates and reference (rounded up), to the bit. */
+static long refs_differing(Lab *lab, const char *params, long *inside_count)
+{
+    Error err;
+    const Technique *t = tech_find("pcf", &err);
+    double values[TECH_MAX_PARAMS];
+    if (!t || !filtered_params(t, params, values)) return -1;
+    ShadowMapSpec spec = smap_spec(values);
+    const ShadowMap *m = res_shadow_map(lab_resources(lab), lab_scene(lab), 0, &spec, &err);
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    if (!m || !vs || !cls) return -1;
+    SmapBias b = smap_bias(values, lab_scene(lab));
+    long differing = 0;
+    *inside_count = 0;
+    for (int first = 0; first < vs->count; first += SMAP_BATCH) {
+        int n = vs->count - first < SMAP_BATCH ? vs->count - first : SMAP_BATCH;
+        SmapReceiver r[SMAP_BATCH];
+        bool inside[SMAP_BATCH];
+        SmapRefs refs;
+        smap_receivers(m, &b, vs->p_world + first, vs->n_geom_world + first, cls + first, n, r, inside);
+        smap_refs(m, &b, vs->p_world + first, vs->n_geom_world + first, cls + first, n, &refs);
+        int candidates = 0;
+        for (int k = 0; k < n; k++) candidates += cls[first + k] == SAMPLE_LIT_CANDIDATE;
+        differing += refs.count != candidates;
+        for (int k = 0; k < refs.count; k++) {
+            const SmapReceiver *o = &r[refs.sample[k]];
+            bool in = inside[refs.sample[k]];
+            *inside_count += in;
+            differing += cls[first + refs.sample[k]] != SAMPLE_LIT_CANDIDATE || refs.inside[k] != in ||
+                         (in && (refs.face[k] != o->mc.face || refs.s[k] != o->mc.s || refs.t[k] != o->mc.t ||
+                                 memcmp(&refs.ref_up[k], &(float){smap_ref_up(o->ref)}, sizeof(float)) != 0));
+        }
+    }
+    return differing;
+}
+
+TEST(test_smap_refs_are_the_receivers_references_to_the_bit)
+{
+    static const char *const sphere[] = {
+        "projection=perspective depth=ndc slope_bias=0 bias_steps=2000",
+        "projection=perspective depth=linear slope_bias=0 bias=0.01 bias_steps=30",
+        "depth=ndc depth_bits=u16 slope_bias=0 bias_steps=3 normal_offset=1",
+        "depth=linear depth_bits=u24 slope_bias=0 bias_steps=3",
+        "depth=ndc slope_bias=1 bias_steps=50",                /* a plane per receiver: through the records */
+        "projection=cube depth=ndc slope_bias=0 bias_steps=9", /* a map the batch path does not serve */
+        NULL};
+    static const char *const overhead[] = {"projection=ortho depth=ndc slope_bias=0 bias_steps=50 normal_offset=2",
+                                           "projection=ortho depth=linear slope_bias=0 bias=0.001", NULL};
+    static const struct { const char *scene; const char *const *cases; } scenes[] = {
+        {"scenes/sphere-on-plane.lua", sphere}, {"scenes/overhead-plane.lua", overhead}};
+    for (int s = 0; s < 2; s++) {
+        Lab *lab = filtered_open(scenes[s].scene, 160, 120);
+        CHECK(lab);
+        for (const char *const *c = scenes[s].cases; *c; c++) {
+            char params[256];
+            snprintf(params, sizeof params, "map_size=256 %s", *c);
+            long inside = 0, differing = refs_differing(lab, params, &inside);
+            printf("    %s %s: %ld inside, %ld differ\n", scenes[s].scene, params, inside, differing);
+            CHECK_MSG(inside > 5000, "%s: only %ld receivers inside", params, inside);
+            CHECK_MSG(differing == 0, "%s: %ld receivers differ from smap_receivers'", params, differing);
+        }
+        lab_close(lab);
+    }
+}
+
+/* pcf's box without the receiver plane (smap_refs, taps 4 to a vector)
+ * against the box counted tap by tap with smap_lit on the sample's
+ * SmapReceiver: lit candidates whose visibility differs at all. */
+static long box_differing(Lab *lab, const char *params, long *candidates)
+{
+    Error err;
+    const Technique *t = tech_find("pcf", &err);
+    double values[TECH_MAX_PARAMS];
+    RenderResult rr = {0};
+    if (!t || !filtered_params(t, params, values) || !filtered_render(lab, "pcf", params, &rr)) return -1;
+    ShadowMapSpec spec = smap_spec(values);
+    const ShadowMap *m = res_shadow_map(lab_resources(lab), lab_scene(lab), 0, &spec, &err);
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    if (!m || !vs || !cls) return -1;
+    SmapBias b = smap_bias(values, lab_scene(lab));
+    int K = (int)values[SMAP_NUM_PARAMS];
+    b.filter_radius = 0.5 * (K - 1);
+    long differing = 0;
+    *candidates = 0;
+    for (int s = 0; s < vs->count; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        SmapReceiver r;
+        float expect = 1.0f;
+        if (smap_receiver(m, &b, vs->p_world[s], vs->n_geom_world[s], &r)) {
+            int i0 = (int)floor(r.mc.s - 0.5 * K + 0.5), j0 = (int)floor(r.mc.t - 0.5 * K + 0.5), lit = 0;
+            for (int j = j0; j < j0 + K; j++)
+                for (int i = i0; i < i0 + K; i++) lit += smap_lit(m, &r, i, j) == 1.0f;
+            expect = (float)lit / (float)(K * K);
+        }
+        (*candidates)++;
+        differing += rr.visibility.data[s] != expect;
+    }
+    render_result_free(&rr);
+    return differing;
+}
+
+TEST(test_pcf_box_counts_as_its_taps_one_by_one_at_every_width_and_edge)
+{
+    /* K = 1, 4 (whole vectors), 5 and 7 (a masked last vector), 15; on a 16^2
+     * map most boxes reach past an edge, on 64^2 few */
+    static const char *const cases[] = {"K=1 map_size=16", "K=4 map_size=16", "K=5 map_size=16", "K=7 map_size=64",
+                                        "K=15 map_size=16", "K=15 map_size=64 depth=ndc slope_bias=0", NULL};
+    Lab *lab = filtered_open("scenes/sphere-on-plane.lua", 160, 120);
+    CHECK(lab);
+    for (const char *const *c = cases; *c; c++) {
+        char params[128];
+        snprintf(params, sizeof params, "kernel=box receiver_plane=0 %s", *c);
+        long candidates = 0, differing = box_differing(lab, params, &candidates);
+        printf("    %s: %ld of %ld lit candidates differ\n", params, differing, candidates);
+        CHECK_MSG(candidates > 5000 && differing == 0, "%s: %ld of %ld lit candidates differ from the taps one by one",
+                  params, differing, candidates);
+    }
+    lab_close(lab);
 }
