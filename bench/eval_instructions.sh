@@ -5,9 +5,10 @@
 # threads), printing the instructions inside lab.c's evaluate_all but
 # outside its parallel loop (serial, inside the timer), each thread's inside
 # it, and the Amdahl bound 1 / (s + largest thread share). Valgrind runs one
-# thread at a time, so the split between threads is its scheduler's, not the
-# machine's: the serial count is the figure to read. OMP_WAIT_POLICY=passive
-# keeps a waiting thread's spinning out of the counts.
+# thread at a time; --fair-sched=yes hands them turns round-robin, so the
+# split is that of two threads of equal speed (without it, evssm's was 48/52
+# and its bound 1.93). OMP_WAIT_POLICY=passive keeps a waiting thread's
+# spinning out of the counts.
 # Usage (from the repository root, after make): bench/eval_instructions.sh sm
 set -eu
 tech=$1
@@ -15,7 +16,7 @@ scene=${2:-scenes/sphere-on-plane.lua}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 SHADOWLAB_MODEL_PATH=${SHADOWLAB_MODEL_PATH:-../shared/models} OMP_WAIT_POLICY=passive \
-    valgrind --tool=callgrind --separate-threads=yes --callgrind-out-file="$dir/cg" \
+    valgrind --tool=callgrind --fair-sched=yes --separate-threads=yes --callgrind-out-file="$dir/cg" \
     build/shadowlab render "$scene" -t "$tech" -s camera.width=640 -s camera.height=480 --threads 2 \
     --repeat 1 --no-png -o "$dir/out" >"$dir/log" 2>&1 || { cat "$dir/log"; exit 1; }
 # inclusive instructions of lab.c's function $2 in thread file $1 (0 if absent)
