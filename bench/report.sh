@@ -437,7 +437,7 @@ trap 'rm -f "$cmp" "$gone" "$sum" "$md.tmp$$"' EXIT
     echo
     table reference_scaling.csv scene rays threads bare_ms_1 bare_ms_n bare_speedup reference_ms_1 reference_ms_n reference_speedup ratio within load_1min
     table raster_threads.csv scene triangles res threads ms_1 ms_n speedup load_1min
-    table threads_eval.csv technique threads ms_1 ms_n speedup light width height load_1min
+    table threads_eval.csv technique threads ms_1 ms_n speedup cpu_ms_1 cpu_ms_n cpu_bound light width height load_1min
     echo "## 6. Peak memory, 4096^2 maps (target <= 1.2)"
     echo
     table memory.csv technique map_res peak_rss_mib resources_mib ratio within baseline_rss_mib note light load_1min

@@ -13,7 +13,8 @@
  *     choice named sat) at K = its minimum and maximum: frame time at the
  *     largest K within 1.2x of the smallest (the papers' claim);
  *   threads: each technique's evaluation, and the Embree reference, on the
- *     curve 1, 2, 4, ... N threads (bench.h's BenchCurve);
+ *     curve 1, 2, 4, ... N threads (bench.h's BenchCurve), with the CPU time
+ *     a technique's threads ran (lab.h's eval_cpu_s, eval_busiest_s);
  *   lightsize: every soft technique that handles sphere lights at light 1's
  *     radius 0.05 and 0.8 (map_size 2048 where it has one; --quick: 1024):
  *     frame time at 0.8 over 0.05, against the 1.2 bound the constant-time
@@ -47,7 +48,7 @@
 #define WHERE_HEADER "scene,light,settings,width,height," BENCH_TAIL_HEADER "\n"
 #define GROWTH_HEADER "technique,axis,value,frame_ms,eval_ms,build_ms,resources_built,note," WHERE_HEADER
 #define CONSTANT_HEADER "technique,prefilter,K_min,K_max,frame_min_ms,frame_max_ms,ratio,bound,within," WHERE_HEADER
-#define THREADS_HEADER "technique,ms_1,ms_n,speedup," WHERE_HEADER
+#define THREADS_HEADER "technique,ms_1,ms_n,speedup,cpu_ms_1,cpu_ms_n,busiest_ms_n,cpu_bound," WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
                           WHERE_HEADER
 #define WORK_HEADER "technique,lit_candidates,texel_fetches_per_sample,texel_bytes_per_sample,rays_per_sample," \
@@ -75,6 +76,7 @@ typedef struct Subject {
 typedef struct Point {
     double frame_s, eval_s, build_s;
     int built;
+    double cpu_s, busiest_s; /* the evaluation's CPU seconds: all threads, the busiest (lab.h) */
 } Point;
 
 static int own_option(void *options, const char *a, const char *v)
@@ -193,7 +195,7 @@ static bool measure(Lab *lab, const Technique *t, const double *params, int repe
     RenderTiming timing = {.warmup = 1, .budget_s = 0.0};
     RenderResult r;
     if (!lab_render_timed(lab, &req, &timing, &r, err)) return false;
-    *p = (Point){r.frame_s, r.eval_median_s, r.tech_build_s, 0};
+    *p = (Point){r.frame_s, r.eval_median_s, r.tech_build_s, 0, r.eval_cpu_s, r.eval_busiest_s};
     for (int i = 0; i < r.num_tech_resources; i++) p->built += r.tech_resources[i].built;
     render_result_free(&r);
     return true;
@@ -399,17 +401,34 @@ static bool light_size(const Options *o, Subject *sj, Error *err)
 typedef struct Scaling {
     Lab *lab;
     const Subject *sj; /* its t NULL: the reference */
+    const BenchCurve *c;
+    /* a technique's evaluation CPU seconds (lab.h) at point k in run i, the
+     * warm-up round's first: cpu[k * (rounds + 1) + i], busiest likewise;
+     * calls[k] the runs so far */
+    double *cpu, *busiest;
+    int calls[BENCH_MAX_CURVE];
 } Scaling;
+
+/* The point of s's curve at `threads`. */
+static int curve_point(const Scaling *s, int threads)
+{
+    int k = 0;
+    while (k < s->c->points - 1 && s->c->threads[k] != threads) k++;
+    return k;
+}
 
 /* One timed evaluation (or reference computation); BenchTimedFn. */
 static bool scaled_once(void *ctx, int side, int threads, double *seconds, Error *err)
 {
-    const Scaling *s = ctx;
-    (void)side, (void)threads;
+    Scaling *s = ctx;
+    (void)side;
     if (s->sj->t) {
         Point p;
         if (!measure(s->lab, s->sj->t, s->sj->params, 1, &p, err)) return false;
         *seconds = p.eval_s;
+        int k = curve_point(s, threads), i = s->calls[k]++;
+        s->cpu[k * (s->c->rounds + 1) + i] = p.cpu_s;
+        s->busiest[k * (s->c->rounds + 1) + i] = p.busiest_s;
         return true;
     }
     ResourceManager *rm = lab_resources(s->lab);
@@ -426,6 +445,27 @@ static bool scaled_once(void *ctx, int side, int threads, double *seconds, Error
     return ok;
 }
 
+/* Median milliseconds of a technique's timed runs at point k (v: s->cpu or s->busiest). */
+static double cpu_median_ms(const Scaling *s, const double *v, int k)
+{
+    return bench_median(v + k * (s->c->rounds + 1) + 1, s->c->rounds) * 1e3;
+}
+
+/* A technique's CPU columns at point k (empty for the reference): CPU
+ * milliseconds on 1 thread and on k, the busiest thread's, and the
+ * speed-up they bound, cpu(1) / busiest(k), which the load does not move. */
+static void cpu_columns(const Scaling *s, int k, char *out, size_t n, double *bound)
+{
+    *bound = NAN;
+    if (!s->sj->t) {
+        snprintf(out, n, ",,,");
+        return;
+    }
+    double cpu1 = cpu_median_ms(s, s->cpu, 0), busiest = cpu_median_ms(s, s->busiest, k);
+    *bound = busiest > 0.0 ? cpu1 / busiest : NAN; /* below the CPU clock's resolution: unknown */
+    snprintf(out, n, "%.4f,%.4f,%.4f,%.3f", cpu1, cpu_median_ms(s, s->cpu, k), busiest, *bound);
+}
+
 /* One row per point of the curve (threads = that point's count). */
 static bool scaling_rows(const Options *o, const Scaling *s, const BenchCurve *c, Error *err)
 {
@@ -434,11 +474,15 @@ static bool scaling_rows(const Options *o, const Scaling *s, const BenchCurve *c
     double ms1 = bench_curve_median_s(c, 0, 0) * 1e3;
     printf("  %-18s 1 thread %9.3f ms", name, ms1);
     for (int k = 0; ok && k < c->points; k++) {
-        char row[2048], end[1024];
-        double msk = bench_curve_median_s(c, 0, k) * 1e3, speedup = bench_curve_speedup(c, 0, k);
+        char row[2048], end[1024], cpu[256];
+        double msk = bench_curve_median_s(c, 0, k) * 1e3, speedup = bench_curve_speedup(c, 0, k), bound;
         where(s->sj, lab_scene(s->lab), c->threads[k], end, sizeof end);
-        snprintf(row, sizeof row, "%s,%.4f,%.4f,%.3f,%s", name, ms1, msk, speedup, end);
+        cpu_columns(s, k, cpu, sizeof cpu, &bound);
+        snprintf(row, sizeof row, "%s,%.4f,%.4f,%.3f,%s,%s", name, ms1, msk, speedup, cpu, end);
         if (k > 0) printf("; %d: %.3f ms, speed-up %.2f", c->threads[k], msk, speedup);
+        if (k > 0 && s->sj->t)
+            printf(" (CPU bound %.2f, CPU %.2fx of 1 thread's)", bound,
+                   cpu_median_ms(s, s->cpu, k) / cpu_median_ms(s, s->cpu, 0));
         ok = append(o, "threads_eval.csv", THREADS_HEADER, row, err);
     }
     printf("\n");
@@ -456,8 +500,14 @@ static bool scaling(const Options *o, Subject *sj, Error *err)
     if (!sj->t) snprintf(sj->light.text, sizeof sj->light.text, "%s", light_kind_name(lab_scene(s.lab)->lights[0].kind));
     if (sj->t) announce(o, sj, "threads");
     BenchCurve c;
-    bool ok = bench_curve_init(&c, o->c.threads, 1, o->c.repeat, err) &&
-              bench_curve_measure(&c, scaled_once, &s, err) && scaling_rows(o, &s, &c, err);
+    bool ok = bench_curve_init(&c, o->c.threads, 1, o->c.repeat, err);
+    size_t runs = ok ? (size_t)c.points * (size_t)(c.rounds + 1) : 0;
+    s.c = &c;
+    s.cpu = runs ? calloc(2 * runs, sizeof *s.cpu) : NULL;
+    s.busiest = s.cpu ? s.cpu + runs : NULL;
+    if (ok && !s.cpu) ok = error_set(err, "out of memory");
+    ok = ok && bench_curve_measure(&c, scaled_once, &s, err) && scaling_rows(o, &s, &c, err);
+    free(s.cpu);
     bench_curve_free(&c);
     lab_close(s.lab);
     return ok;

@@ -84,30 +84,40 @@ bool lab_light_index(const Lab *lab, int number, int *index, Error *err)
     return true;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
+/* One evaluation's times: wall clock, and the CPU seconds its threads ran
+ * inside the loop, all of them together and the busiest one. */
+typedef struct EvalTimes {
+    double wall_s, cpu_s, busiest_s;
+} EvalTimes;
 
-/* One timed evaluation of every row, in parallel; its work into *work
- * (counted by the shared readers in every thread, core/counters.h). */
-static double evaluate_all(const Technique *t, const void *state, const TechContext *ctx, Image *out,
-                           WorkCounters *work)
+/* One timed evaluation of every row, in parallel (one row at a time to
+ * whichever thread is free: rows differ in cost); its work into *work
+ * (counted by the shared readers in every thread, core/counters.h). Each
+ * thread reads its own CPU clock around its share of the rows. */
+static EvalTimes evaluate_all(const Technique *t, const void *state, const TechContext *ctx, Image *out,
+                              WorkCounters *work)
 {
     const ViewSamples *vs = ctx->vs;
     WorkCounters w0, w1;
     work_snapshot(&w0);
+    double cpu_s = 0.0, busiest_s = 0.0;
     double t0 = timer_now_s();
-#pragma omp parallel for schedule(dynamic, 1)
-    for (int y = 0; y < vs->height; y++) {
-        int begin = y * vs->width;
-        t->evaluate(state, ctx, begin, begin + vs->width, out->data + (size_t)begin * (size_t)ctx->channels);
+#pragma omp parallel reduction(+ : cpu_s) reduction(max : busiest_s)
+    {
+        double c0 = timer_thread_cpu_s();
+#pragma omp for schedule(dynamic, 1) nowait
+        for (int y = 0; y < vs->height; y++) {
+            int begin = y * vs->width;
+            t->evaluate(state, ctx, begin, begin + vs->width, out->data + (size_t)begin * (size_t)ctx->channels);
+        }
+        double own_s = timer_thread_cpu_s() - c0;
+        cpu_s += own_s;
+        busiest_s = own_s; /* this thread's copy; the reduction keeps the largest */
     }
-    double dt = timer_now_s() - t0;
+    EvalTimes et = {timer_now_s() - t0, cpu_s, busiest_s};
     work_snapshot(&w1);
     *work = work_diff(&w1, &w0);
-    return dt;
+    return et;
 }
 
 /* Convention for samples outside the evaluated class; broadcast a 1-channel
@@ -126,35 +136,39 @@ static void finish_image(Image *img, int tech_channels, const uint8_t *cls)
 }
 
 /* Warm-ups, then timed repeats (see RenderTiming); sets repeat and warmup to
- * the counts that ran. */
+ * the counts that ran, and the medians of the timed ones' times. */
 static bool run_evaluations(const RenderRequest *req, const RenderTiming *timing, const void *state,
                             const TechContext *ctx, RenderResult *out)
 {
-    double *times = malloc(sizeof(double) * (size_t)req->repeat);
+    double *times = malloc(sizeof(double) * 3 * (size_t)req->repeat);
     if (!times) return false;
+    double *cpu = times + req->repeat, *busiest = cpu + req->repeat;
     int n = 0;
     double total = 0;
     Progress prog; /* the progress line's "evaluate 3/10" (core/progress.h) */
     progress_begin(&prog, "evaluate", timing->warmup + req->repeat);
     for (out->warmup = 0; out->warmup < timing->warmup; out->warmup++) {
-        double t = evaluate_all(req->tech, state, ctx, &out->visibility, &out->eval_work);
+        EvalTimes et = evaluate_all(req->tech, state, ctx, &out->visibility, &out->eval_work);
         progress_add(&prog, 1);
-        if (timing->budget_s > 0 && t >= timing->budget_s) {
-            times[n++] = total = t; /* long enough that caches cannot matter: it is the timed one */
+        if (timing->budget_s > 0 && et.wall_s >= timing->budget_s) {
+            /* long enough that caches cannot matter: it is the timed one */
+            times[0] = total = et.wall_s, cpu[0] = et.cpu_s, busiest[0] = et.busiest_s, n = 1;
             break;
         }
     }
     while (n < req->repeat && (n == 0 || timing->budget_s <= 0 || total < timing->budget_s)) {
-        times[n] = evaluate_all(req->tech, state, ctx, &out->visibility, &out->eval_work);
+        EvalTimes et = evaluate_all(req->tech, state, ctx, &out->visibility, &out->eval_work);
+        times[n] = et.wall_s, cpu[n] = et.cpu_s, busiest[n] = et.busiest_s;
         total += times[n++];
         progress_add(&prog, 1);
     }
     progress_end(&prog);
-    qsort(times, (size_t)n, sizeof(double), cmp_double);
     out->repeat = n;
+    out->eval_median_s = timer_median(times, n); /* sorts: min and max at the ends */
     out->eval_min_s = times[0];
     out->eval_max_s = times[n - 1];
-    out->eval_median_s = n % 2 ? times[n / 2] : 0.5 * (times[n / 2 - 1] + times[n / 2]);
+    out->eval_cpu_s = timer_median(cpu, n);
+    out->eval_busiest_s = timer_median(busiest, n);
     free(times);
     return true;
 }

@@ -42,6 +42,13 @@ typedef struct RenderResult {
     double view_s;         /* view samples + classes (0 when reused) */
     double prepare_s;      /* the technique's resource acquisition and set-up */
     double eval_median_s, eval_min_s, eval_max_s; /* over the timed evaluations */
+    /* CPU seconds the evaluation loop ran (each thread's CLOCK_THREAD_CPUTIME_ID
+     * over its share of the rows; medians over the timed evaluations): on all
+     * its threads together, and on the busiest. What other programs take of
+     * the machine is in neither, so a 1-thread run's eval_cpu_s over a k-thread
+     * run's eval_busiest_s is the speed-up k cores of its own would give, and
+     * eval_cpu_s growing with k is contention (shared caches, memory). */
+    double eval_cpu_s, eval_busiest_s;
     int repeat;
     int warmup;
     /* What the technique's prepare depends on (a resources.h scope: what it

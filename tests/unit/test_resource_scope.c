@@ -7,11 +7,12 @@
  * time on map techniques: fit=view charges the fit's reduction, not the view
  * samples (the G-buffer); a constant table is set-up, built once across a
  * sweep; the frame resources' builds are repeated with the evaluations and
- * their median reported. */
+ * their median reported; the evaluation's CPU time sums every thread's. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <omp.h>
 #include "fixtures.h"
 #include "lab/compare.h"
 #include "test.h"
@@ -168,6 +169,36 @@ TEST(test_time_budget_stops_timed_repeats_and_says_how_many_ran)
     render_result_free(&tiny);
     RenderTiming negative = {1, -1.0};
     CHECK(!lab_render_timed(lab, &rq, &negative, &tiny, &err) && strstr(err.msg, "budget"));
+    lab_close(lab);
+}
+
+/* The evaluation's CPU seconds (lab.h) sum every thread's share and name the
+ * busiest: one thread's are both its own, two threads' busiest is within the
+ * sum, and no thread ran longer than the evaluation took. */
+TEST(test_evaluation_cpu_time_sums_every_thread_and_names_the_busiest)
+{
+    Error err;
+    Lab *lab = fixture_lab("cpu.lua", scope_scene);
+    CHECK(lab);
+    const Technique *hard = tech_find("hard", &err);
+    double params[TECH_MAX_PARAMS];
+    tech_params_default(hard, params);
+    RenderRequest rq = {hard, params, 0, 3};
+    RenderTiming warm = {1, 0.0};
+    int threads = omp_get_max_threads();
+    for (int n = 1; n <= 2; n++) {
+        RenderResult r;
+        omp_set_num_threads(n);
+        CHECK(lab_render_timed(lab, &rq, &warm, &r, &err));
+        CHECK_MSG(r.eval_busiest_s > 0.0 && r.eval_busiest_s <= r.eval_cpu_s, "%d threads: busiest %g s, all %g s", n,
+                  r.eval_busiest_s, r.eval_cpu_s);
+        CHECK_MSG(r.eval_busiest_s <= r.eval_max_s && r.eval_cpu_s <= n * r.eval_max_s,
+                  "%d threads: CPU %g s (busiest %g s) over a %g s evaluation", n, r.eval_cpu_s, r.eval_busiest_s,
+                  r.eval_max_s);
+        if (n == 1) CHECK(r.eval_cpu_s == r.eval_busiest_s);
+        render_result_free(&r);
+    }
+    omp_set_num_threads(threads);
     lab_close(lab);
 }
 
