@@ -166,6 +166,9 @@ plot x with lines dashtype 2 title 'ideal'"
     echo "Constant in the light's size (the prefiltered PCSS family and occlusion textures claim it; pcss grows):"
     echo
     table light_size.csv technique map_size radius_small radius_large frame_small_ms frame_large_ms ratio within scene threads load_1min
+    echo "Where a technique refused the asked map size (its own cap), the size it was measured at and why:"
+    echo
+    table light_size.csv technique map_size settings note
     echo "Machine-independent work per technique (core/counters.h), beside the hand count where one is known:"
     echo
     table work.csv technique texel_fetches_per_sample rays_per_sample frame_triangles frame_fragments frame_bytes_built hand_rule agrees light

@@ -57,6 +57,10 @@ run "$bin/techniques" --only constant -t esm -p classifier=none -p exponent=20 -
     --repeat "$repeat" -o "$out"
 # constant in the light's size (course §5.2.2, §5.2.5): every soft technique on the bunny, radius 0.05 and 0.8
 run "$bin/techniques" --only lightsize $q --threads "$threads" --repeat "$repeat" -o "$out" scenes/bunny.lua
+# pcss at its defaults reads 16 + 16 Poisson taps whatever the light: constant by construction; reading every
+# texel of its windows (up to its max_radius = 32 texels) it grows
+run "$bin/techniques" --only lightsize -t pcss -p sampling=exhaustive $q --threads "$threads" --repeat "$repeat" \
+    -o "$out" scenes/bunny.lua
 # machine-independent work counters beside the hand counts (160x120; exits 1 on a disagreement)
 run "$bin/techniques" --only work --threads "$threads" -o "$out"
 

@@ -15,7 +15,8 @@
  *   threads: each technique's evaluation, and the Embree reference, on the
  *     curve 1, 2, 4, ... N threads (bench.h's BenchCurve);
  *   lightsize: every soft technique that handles sphere lights at light 1's
- *     radius 0.05 and 0.8 (map_size 2048 where it has one; --quick: 1024):
+ *     radius 0.05 and 0.8 (map_size 2048 where it has one; --quick: 1024;
+ *     -p map_size=N: N; where it refuses that size, the largest half it accepts):
  *     frame time at 0.8 over 0.05, against the 1.2 bound the constant-time
  *     claims name (prefiltered PCSS, CSSM, VSSM, ESSM, moment soft shadows:
  *     course §5.2.2; occlusion textures: §5.2.5), `pcss` beside them growing;
@@ -49,7 +50,9 @@
 #define CONSTANT_HEADER "technique,prefilter,K_min,K_max,frame_min_ms,frame_max_ms,ratio,bound,within," WHERE_HEADER
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup," WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
-                          WHERE_HEADER
+                          "note," WHERE_HEADER
+#define LIGHT_SMALL 0.05 /* light 1's radii of the lightsize part, world units */
+#define LIGHT_LARGE 0.8
 #define WORK_HEADER "technique,lit_candidates,texel_fetches_per_sample,texel_bytes_per_sample,rays_per_sample," \
                     "frame_triangles,frame_fragments,frame_texel_fetches,frame_rays,frame_bytes_built,hand_rule," \
                     "hand_texel_fetches_per_sample,hand_rays_per_sample,agrees," WHERE_HEADER
@@ -371,26 +374,58 @@ static bool at_radius(const Options *o, Subject *sj, const double *params, doubl
     return ok;
 }
 
-static bool light_size(const Options *o, Subject *sj, Error *err)
+/* Whether -p assigned the parameter `name` (a part then leaves it as given). */
+static bool assigned(const Options *o, const char *name)
 {
-    static const double small = 0.05, large = 0.8;
-    const Technique *t = sj->t;
+    for (int i = 0; i < o->num_settings; i++)
+        if (strcmp(param_name(o->settings[i]).s, name) == 0) return true;
+    return false;
+}
+
+/* Frame times at both radii at map_size `map_size` (0: the technique has none). */
+static bool both_radii(const Options *o, Subject *sj, int map_size, Point *lo, Point *hi, char *end, size_t n,
+                       Error *err)
+{
     double params[TECH_MAX_PARAMS];
     memcpy(params, sj->params, sizeof params);
-    int ms = tech_param_index(t, "map_size"), map_size = o->quick ? 1024 : 2048;
+    int ms = tech_param_index(sj->t, "map_size");
     if (ms >= 0) params[ms] = map_size;
-    announce(o, sj, "lightsize");
+    return at_radius(o, sj, params, LIGHT_SMALL, lo, NULL, 0, err) &&
+           at_radius(o, sj, params, LIGHT_LARGE, hi, end, n, err);
+}
+
+/* At map_size 2048 (--quick: 1024; -p map_size=N: N), or, where the technique
+ * refuses that with its own error (a resource over its cap), at the first of
+ * half, a quarter, ... (down to 256) it accepts, as memory.c does; the row's
+ * note names the size refused and why. Only a technique that refuses every
+ * size (or has no map_size and refuses) fails. */
+static bool light_size(const Options *o, Subject *sj, Error *err)
+{
+    const Technique *t = sj->t;
+    int ms = tech_param_index(t, "map_size");
+    int map_size = ms < 0 ? 0 : assigned(o, "map_size") ? (int)sj->params[ms] : o->quick ? 1024 : 2048;
     Point lo, hi;
-    char end[1024];
-    if (!at_radius(o, sj, params, small, &lo, NULL, 0, err) ||
-        !at_radius(o, sj, params, large, &hi, end, sizeof end, err))
-        return false;
+    char end[1024], note[1200] = "";
+    while (!both_radii(o, sj, map_size, &lo, &hi, end, sizeof end, err)) {
+        if (ms < 0 || map_size / 2 < 256) return false;
+        if (!note[0]) {
+            char why[1100];
+            snprintf(why, sizeof why, "map_size %d REFUSED (%s); measured at the largest half accepted", map_size,
+                     err->msg);
+            bench_csv_field(note, sizeof note, why);
+        }
+        printf("  %-18s map_size %d REFUSED (%s); trying %d\n", t->name, map_size, err->msg, map_size / 2);
+        map_size /= 2;
+    }
+    announce(o, sj, "lightsize");
     double ratio = hi.frame_s / lo.frame_s;
-    char row[2048];
-    snprintf(row, sizeof row, "%s,%d,%g,%g,%.4f,%.4f,%.3f,%.1f,%s,%s", t->name, ms >= 0 ? map_size : 0, small, large,
-             lo.frame_s * 1e3, hi.frame_s * 1e3, ratio, CONSTANT_BOUND, ratio <= CONSTANT_BOUND ? "yes" : "no", end);
-    printf("  %-18s radius %g: %.3f ms, radius %g: %.3f ms, ratio %.2f (bound %.1f)%s\n", t->name, small,
-           lo.frame_s * 1e3, large, hi.frame_s * 1e3, ratio, CONSTANT_BOUND, ratio <= CONSTANT_BOUND ? "" : "  OVER");
+    char row[4096];
+    snprintf(row, sizeof row, "%s,%d,%g,%g,%.4f,%.4f,%.3f,%.1f,%s,%s,%s", t->name, map_size, LIGHT_SMALL, LIGHT_LARGE,
+             lo.frame_s * 1e3, hi.frame_s * 1e3, ratio, CONSTANT_BOUND, ratio <= CONSTANT_BOUND ? "yes" : "no", note,
+             end);
+    printf("  %-18s map_size %d: radius %g: %.3f ms, radius %g: %.3f ms, ratio %.2f (bound %.1f)%s\n", t->name,
+           map_size, LIGHT_SMALL, lo.frame_s * 1e3, LIGHT_LARGE, hi.frame_s * 1e3, ratio, CONSTANT_BOUND,
+           ratio <= CONSTANT_BOUND ? "" : "  OVER");
     return append(o, "light_size.csv", LIGHT_SIZE_HEADER, row, err);
 }
 
