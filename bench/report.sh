@@ -102,6 +102,36 @@ plot "
         done
         [ $first = 1 ] || plot growth_main "$script"
     fi
+    if [ -f "$dir/sweep.csv" ]; then
+        script="set title 'Evaluation time per lit candidate per unit of the axis, over the first value''s'
+set xlabel 'axis value'; set ylabel 'ratio (linear: 1)'; set logscale x; set grid; set key outside right noenhanced
+plot 1 with lines dashtype 2 title 'linear'"
+        for ta in $(column "$dir/sweep.csv" technique axis | tr ' ' '@' | sort -u); do
+            t=${ta%%@*} a=${ta#*@} d="$dir/sweep_$(printf '%s' "$ta" | tr -c 'A-Za-z0-9_\n' '_').dat"
+            column "$dir/sweep.csv" technique axis value per_value_ratio |
+                awk -v t="$t" -v a="$a" '$1 == t && $2 == a { print $3, $4 }' > "$d"
+            script="$script, '$d' using 1:2 with linespoints title '$t, $a'"
+        done
+        plot sweep "$script"
+    fi
+    if [ -f "$dir/matched_curve.csv" ]; then
+        for s in $(column "$dir/matched_curve.csv" scene | sort -u); do
+            script="set title 'Penumbra RMSE against frame time, $s (map sizes 256 ... 2048)'
+set xlabel 'frame time (ms)'; set ylabel 'penumbra RMSE'; set logscale xy; set grid; set key outside right noenhanced
+plot "
+            first=1
+            for t in $(column "$dir/matched_curve.csv" technique | sort -u); do
+                d="$dir/matched_${s}_$t.dat"
+                column "$dir/matched_curve.csv" scene technique frame_ms penumbra_rmse |
+                    awk -v s="$s" -v t="$t" '$1 == s && $2 == t { print $3, $4 }' > "$d"
+                [ -s "$d" ] || { rm -f "$d"; continue; }
+                [ $first = 1 ] || script="$script, "
+                script="$script'$d' using 1:2 with linespoints title '$t'"
+                first=0
+            done
+            [ $first = 1 ] || plot "matched_$s" "$script"
+        done
+    fi
     if [ -f "$dir/threads_eval.csv" ]; then
         n=$(column "$dir/threads_eval.csv" threads | sort -n | tail -1)
         script="set title 'Speed-up over 1 thread, 1 to $n threads (ideal: the diagonal)'
@@ -192,6 +222,28 @@ plot x with lines dashtype 2 title 'ideal'"
     echo
     table silhouette.csv segments triangles silhouette_edges build_ms ns_per_triangle ns_per_triangle_over_smallest threads load_1min
     table volumes.csv scene triangles versus map_size shadow_volume_ms other_ms ratio threads load_1min commit
+    echo "view_sample_mapping against the Embree reference at 256 light samples on the same view, and its frame time"
+    echo "per (caster triangle, lit candidate) pair against the ball's triangles:"
+    echo
+    table vsm_reference.csv scene triangles width height samples vsm_ms reference_ms ratio threads load_1min commit
+    table vsm_triangles.csv segments triangles lit_candidates frame_ms ns_per_triangle_sample ns_per_triangle_sample_over_smallest threads load_1min
+    echo "## 9. Cost against one axis (issue 15) and error against time at pcss's penumbra RMSE (issue 16)"
+    echo
+    echo "Per lit candidate per unit of the axis, over the first value's (linear: near 1); ratios are medians of per-round ratios:"
+    echo
+    echo "![cost per unit](sweep.svg)"
+    echo
+    table sweep.csv technique axis value settings frame_ms eval_ms eval_ns_per_sample eval_ns_per_sample_per_value frame_ratio eval_ratio frame_per_value_ratio per_value_ratio threads load_1min
+    echo "Each technique's penumbra RMSE against frame time over map sizes (plots: one per scene):"
+    echo
+    [ -f "$dir/matched_curve.csv" ] &&
+        for s in $(column "$dir/matched_curve.csv" scene | sort -u); do echo "![$s](matched_$s.svg)"; done
+    echo
+    table matched_curve.csv technique scene map_size penumbra_rmse penumbra_noise_rms penumbra_samples frame_ms eval_ms note threads load_1min
+    echo "The frame time each needs at pcss's penumbra RMSE (pcss at its defaults), over pcss's (reached: interpolated"
+    echo "in log-log on the curve, at_first_point: already below it at 256^2, an upper bound; no: not reached):"
+    echo
+    table matched.csv technique scene target_rmse pcss_frame_ms frame_at_target_ms ratio reached note threads load_1min
 } > "$md"
 plots
 echo "report: $md"

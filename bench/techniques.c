@@ -39,6 +39,8 @@
 #include <string.h>
 #include "bench.h"
 #include "core/timer.h"
+#include "lab/compare.h"
+#include "resources/refcache.h"
 #include "techniques/smap.h"
 
 #define MAX_ITEMS 32
@@ -53,6 +55,11 @@
                           "note," WHERE_HEADER
 #define LIGHT_SMALL 0.05 /* light 1's radii of the lightsize part, world units */
 #define LIGHT_LARGE 0.8
+#define SWEEP_HEADER "technique,axis,value,frame_ms,eval_ms,lit_candidates,eval_ns_per_sample," \
+                     "eval_ns_per_sample_per_value,frame_ratio,eval_ratio,frame_per_value_ratio,per_value_ratio," WHERE_HEADER
+#define CURVE_HEADER "technique,map_size,penumbra_rmse,penumbra_noise_rms,penumbra_samples,frame_ms,eval_ms,note," \
+                     WHERE_HEADER
+#define MATCHED_HEADER "technique,target_rmse,pcss_frame_ms,frame_at_target_ms,ratio,reached,note," WHERE_HEADER
 #define WORK_HEADER "technique,lit_candidates,texel_fetches_per_sample,texel_bytes_per_sample,rays_per_sample," \
                     "frame_triangles,frame_fragments,frame_texel_fetches,frame_rays,frame_bytes_built,hand_rule," \
                     "hand_texel_fetches_per_sample,hand_rays_per_sample,agrees," WHERE_HEADER
@@ -63,6 +70,11 @@ typedef struct Options {
     const char *techs[MAX_ITEMS], *settings[MAX_ITEMS];
     int num_techs, num_settings;
     bool quick;
+    const char *sweep; /* --sweep NAME=V1,V2,...: the sweep part's axis */
+    char axis[128];    /* its NAME: a technique parameter, or a scene key (holds '.' or '[') */
+    double values[MAX_POINTS];
+    int num_values;
+    int samples;       /* --samples N: the matched part's reference light samples */
 } Options;
 
 /* One technique as measured: its parameters (defaults, then -p) and light. */
@@ -78,6 +90,7 @@ typedef struct Subject {
 typedef struct Point {
     double frame_s, eval_s, build_s;
     int built;
+    long lit; /* lit candidates evaluated (what per-sample costs divide by) */
 } Point;
 
 static int own_option(void *options, const char *a, const char *v)
@@ -86,6 +99,8 @@ static int own_option(void *options, const char *a, const char *v)
     if (strcmp(a, "--quick") == 0) return o->quick = true;
     if (!v) return 0;
     if (strcmp(a, "--only") == 0) o->only = v;
+    else if (strcmp(a, "--sweep") == 0 && strchr(v, '=')) o->sweep = v;
+    else if (strcmp(a, "--samples") == 0) return bench_parse_int(v, 1, REFERENCE_MAX_SAMPLES, &o->samples) ? 2 : 0;
     else if (strcmp(a, "-t") == 0 && o->num_techs < MAX_ITEMS) o->techs[o->num_techs++] = v;
     else if (strcmp(a, "-p") == 0 && o->num_settings < MAX_ITEMS && strchr(v, '=')) o->settings[o->num_settings++] = v;
     else return 0;
@@ -110,6 +125,9 @@ static ParamName param_name(const char *assignment)
     return n;
 }
 
+/* Whether the --sweep axis is a scene key (lights[1].radius), not a parameter. */
+static bool sweep_on_scene(const Options *o) { return strchr(o->axis, '.') || strchr(o->axis, '['); }
+
 /* Whether a technique -t selects has the parameter -p assigns (a typo is refused). */
 static bool setting_used(const Options *o, const char *assignment)
 {
@@ -120,13 +138,35 @@ static bool setting_used(const Options *o, const char *assignment)
     return false;
 }
 
+/* --sweep NAME=V1,V2,...: at most MAX_POINTS numbers, a scene key or a
+ * parameter of a selected technique. */
+static bool parse_sweep(Options *o)
+{
+    snprintf(o->axis, sizeof o->axis, "%s", param_name(o->sweep).s);
+    const char *v = strchr(o->sweep, '=') + 1;
+    while (*v) {
+        char *end;
+        double x = strtod(v, &end);
+        if (end == v || !isfinite(x) || o->num_values == MAX_POINTS || (*end && *end != ',')) {
+            fprintf(stderr, "techniques: --sweep %s: expected NAME=V1,V2,... with at most %d finite numbers\n",
+                    o->sweep, MAX_POINTS);
+            return false;
+        }
+        o->values[o->num_values++] = x;
+        v = *end ? end + 1 : end;
+    }
+    if (o->num_values == 0) return false;
+    return sweep_on_scene(o) || setting_used(o, o->sweep);
+}
+
 static bool parse_options(int argc, char **argv, Options *o)
 {
-    *o = (Options){.quick = false};
+    *o = (Options){.quick = false, .samples = 64};
     if (!bench_parse(argc, argv, 3, &o->c, own_option, o) || o->c.num_scenes > 1) return false;
-    if (o->only && strcmp(o->only, "growth") != 0 && strcmp(o->only, "constant") != 0 &&
-        strcmp(o->only, "threads") != 0 && strcmp(o->only, "lightsize") != 0 && strcmp(o->only, "work") != 0)
-        return false;
+    static const char *const parts[] = {"growth", "constant", "threads", "lightsize", "work", "sweep", "matched"};
+    bool known = !o->only;
+    for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++) known = known || strcmp(o->only, parts[i]) == 0;
+    if (!known || (o->only && strcmp(o->only, "sweep") == 0 && !o->sweep)) return false;
     for (int i = 0; i < o->num_techs; i++) {
         Error err;
         if (strcmp(o->techs[i], "reference") == 0 || tech_find(o->techs[i], &err)) continue;
@@ -135,6 +175,7 @@ static bool parse_options(int argc, char **argv, Options *o)
     }
     for (int i = 0; i < o->num_settings; i++)
         if (!setting_used(o, o->settings[i])) return false;
+    if (o->sweep && !parse_sweep(o)) return false;
     o->scene = o->c.num_scenes ? o->c.scenes[0] : "scenes/sphere-on-plane.lua";
     return true;
 }
@@ -196,7 +237,7 @@ static bool measure(Lab *lab, const Technique *t, const double *params, int repe
     RenderTiming timing = {.warmup = 1, .budget_s = 0.0};
     RenderResult r;
     if (!lab_render_timed(lab, &req, &timing, &r, err)) return false;
-    *p = (Point){r.frame_s, r.eval_median_s, r.tech_build_s, 0};
+    *p = (Point){r.frame_s, r.eval_median_s, r.tech_build_s, 0, r.lit_candidates};
     for (int i = 0; i < r.num_tech_resources; i++) p->built += r.tech_resources[i].built;
     render_result_free(&r);
     return true;
@@ -429,6 +470,239 @@ static bool light_size(const Options *o, Subject *sj, Error *err)
     return append(o, "light_size.csv", LIGHT_SIZE_HEADER, row, err);
 }
 
+/* ---- cost against one axis (--sweep) ---------------------------------------- */
+
+/* Median over rounds of point k's per-round time over point 0's, times
+ * scale (t[r * n + k]: round r, point k). */
+static double round_ratio(const double *t, int rounds, int n, int k, double scale)
+{
+    double v[64];
+    for (int r = 0; r < rounds; r++) v[r] = t[r * n + k] / t[r * n] * scale;
+    return bench_median(v, rounds);
+}
+
+/* Median over rounds of point k's time. */
+static double round_median(const double *t, int rounds, int n, int k)
+{
+    double v[64];
+    for (int r = 0; r < rounds; r++) v[r] = t[r * n + k];
+    return bench_median(v, rounds);
+}
+
+/* The subject at every value of the --sweep axis (320 x 240): a parameter in
+ * one Lab, a scene key in one Lab per value. Every round times each value
+ * once, in order (measure's own warm-up before each); rows give the medians,
+ * the evaluation's ns per lit candidate and per lit candidate per unit of
+ * the value, and the medians of the per-round ratios to the first value:
+ * of the frame and evaluation times, and of both per lit candidate per unit
+ * of the value (linear in it: near 1). */
+static bool sweep_cost(const Options *o, Subject *sj, Error *err)
+{
+    int n = o->num_values, rounds = o->c.repeat > 64 ? 64 : o->c.repeat;
+    int pi = sweep_on_scene(o) ? -1 : tech_param_index(sj->t, o->axis);
+    Lab *labs[MAX_POINTS] = {0};
+    double params[MAX_POINTS][TECH_MAX_PARAMS], frame[64 * MAX_POINTS], eval[64 * MAX_POINTS];
+    long lit[MAX_POINTS] = {0};
+    bool ok = true;
+    for (int k = 0; ok && k < n; k++) {
+        memcpy(params[k], sj->params, sizeof params[k]);
+        if (pi >= 0) params[k][pi] = o->values[k];
+        if (k > 0 && pi >= 0) {
+            labs[k] = labs[0];
+            continue;
+        }
+        char key[192];
+        snprintf(key, sizeof key, "%s=%.17g", o->axis, o->values[k]);
+        const char *ov[] = {"camera.width=320", "camera.height=240", key};
+        ok = (labs[k] = open_lab(o, sj, ov, pi >= 0 ? 2 : 3, err)) != NULL;
+    }
+    if (ok) announce(o, sj, "sweep");
+    for (int r = 0; ok && r < rounds; r++)
+        for (int k = 0; ok && k < n; k++) {
+            Point p;
+            ok = measure(labs[k], sj->t, params[k], 1, &p, err);
+            frame[r * n + k] = p.frame_s;
+            eval[r * n + k] = p.eval_s;
+            lit[k] = p.lit;
+        }
+    for (int k = 0; ok && k < n; k++) {
+        double f = round_median(frame, rounds, n, k), e = round_median(eval, rounds, n, k);
+        double per_sample = lit[k] > 0 ? e * 1e9 / (double)lit[k] : NAN; /* no lit candidate: NaN, shown */
+        double per_value = o->values[k] != 0.0 ? per_sample / o->values[k] : NAN;
+        double fr = round_ratio(frame, rounds, n, k, 1.0), er = round_ratio(eval, rounds, n, k, 1.0);
+        /* per lit candidate per unit, over the first value's: the lit counts
+         * differ with a scene key (a light's size moves the shadow) */
+        double scale = lit[0] > 0 && lit[k] > 0 && o->values[k] != 0.0
+                           ? (double)lit[0] / (double)lit[k] * o->values[0] / o->values[k] : NAN;
+        double pvr = round_ratio(eval, rounds, n, k, scale), fpvr = round_ratio(frame, rounds, n, k, scale);
+        char row[4096], end[1024];
+        where(sj, lab_scene(labs[k]), o->c.threads, end, sizeof end);
+        snprintf(row, sizeof row, "%s,%s,%g,%.4f,%.4f,%ld,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%s", sj->t->name, o->axis,
+                 o->values[k], f * 1e3, e * 1e3, lit[k], per_sample, per_value, fr, er, fpvr, pvr, end);
+        printf("  %-18s %s %-8g frame %9.3f ms, eval %9.3f ms, %9.2f ns per lit sample, %8.3f per unit; "
+               "ratios to the first: frame %.3f, eval %.3f, per sample per unit: frame %.3f, eval %.3f\n",
+               sj->t->name, o->axis, o->values[k], f * 1e3, e * 1e3, per_sample, per_value, fr, er, fpvr, pvr);
+        ok = append(o, "sweep.csv", SWEEP_HEADER, row, err);
+    }
+    for (int k = 0; k < n; k++)
+        if (k == 0 || pi < 0) lab_close(labs[k]);
+    return ok;
+}
+
+/* ---- error against time at pcss's penumbra RMSE (issue 16) -------------------- */
+
+/* The prefiltered PCSS family of course §5.2.2 that issue 16 sets against pcss. */
+static const char *const matched_family[] = {"pcss", "pcss_prefiltered", "cssm", "vssm", "essm",
+                                             "evssm", "moment_soft", "dpcf"};
+
+static bool in_matched_family(const char *name)
+{
+    for (size_t i = 0; i < sizeof matched_family / sizeof matched_family[0]; i++)
+        if (strcmp(matched_family[i], name) == 0) return true;
+    return false;
+}
+
+/* One configuration of a curve: its penumbra error (once: it does not vary)
+ * and, per round, its frame time. */
+typedef struct CurvePoint {
+    int map_size;
+    double params[TECH_MAX_PARAMS];
+    double rmse, noise_rms;
+    long samples;
+    double frame[64], eval[64];
+} CurvePoint;
+
+/* The penumbra RMSE of one configuration against the Embree reference
+ * (o->samples light samples, r2, seed 1; the disk cache). */
+static bool penumbra_error(const Options *o, Lab *lab, const Technique *t, CurvePoint *cp, Error *err)
+{
+    char cache[1024];
+    refcache_default_dir(cache, sizeof cache);
+    CompareRequest req = {.tech = t, .params = cp->params, .light_index = 0, .repeat = 1, .warmup = 0,
+                          .reference = true, .ref = {MEASURE_VISIBILITY, o->samples, SAMPLING_R2, 1},
+                          .cache_dir = cache};
+    CompareResult res;
+    if (!lab_compare(lab, &req, &res, err)) return false;
+    const ErrorStats *pen = &res.metrics.region[REGION_PENUMBRA];
+    cp->rmse = pen->rmse;
+    cp->noise_rms = pen->noise_rms;
+    cp->samples = pen->count;
+    compare_result_free(&res);
+    return true;
+}
+
+/* The frame time at RMSE `target` on a curve in order of map size, in one
+ * round: log-log interpolation on the first segment that brackets it; the
+ * first point's time where that point is already at or below it (an upper
+ * bound); NaN where no point reaches it. *how says which. */
+static double time_at_rmse(const CurvePoint *c, int n, int round, double target, const char **how)
+{
+    *how = "no";
+    if (n > 0 && c[0].rmse <= target) {
+        *how = "at_first_point";
+        return c[0].frame[round];
+    }
+    for (int k = 0; k + 1 < n; k++) {
+        double ra = c[k].rmse, rb = c[k + 1].rmse;
+        if (!(ra > target && rb <= target)) continue; /* NaN rmse: not a bracket */
+        *how = "interpolated";
+        double ta = c[k].frame[round], tb = c[k + 1].frame[round];
+        double u = ra == rb ? 0.0 : (log(target) - log(ra)) / (log(rb) - log(ra)); /* ra > target >= rb > 0 */
+        return exp(log(ta) + u * (log(tb) - log(ta)));
+    }
+    return NAN;
+}
+
+/* The subject's curve over map sizes 256 ... 2048 (--quick: ... 1024) and
+ * pcss at its defaults (the target: its penumbra RMSE and frame time), in
+ * one Lab at 240 x 180 (--quick: 160 x 120), timed alternately in every
+ * round; the time the subject needs at pcss's RMSE over pcss's time is the
+ * median of the per-round ratios. A map size the subject refuses is noted
+ * and left out of the curve. */
+static bool matched(const Options *o, Subject *sj, Error *err)
+{
+    static const int maps[] = {256, 512, 1024, 2048};
+    int nmaps = o->quick ? 3 : 4, rounds = o->c.repeat > 64 ? 64 : o->c.repeat;
+    const char *ov[] = {o->quick ? "camera.width=160" : "camera.width=240",
+                        o->quick ? "camera.height=120" : "camera.height=180"};
+    Subject base;
+    const Technique *pcss = tech_find("pcss", err);
+    if (!pcss || !subject_init(o, pcss, &base, err)) return false;
+    Lab *lab = open_lab(o, sj, ov, 2, err);
+    if (!lab) return false;
+    CurvePoint *c = calloc((size_t)nmaps + 1, sizeof *c), *target = NULL;
+    char note[1200] = "", curve_note[64] = "", end[1024];
+    int n = 0, ms = tech_param_index(sj->t, "map_size");
+    bool ok = c != NULL && ms >= 0;
+    if (!c) error_set(err, "out of memory");
+    else if (ms < 0) error_set(err, "%s has no map_size to sweep", sj->t->name);
+    for (int k = 0; ok && k < nmaps; k++) {
+        CurvePoint *cp = &c[n];
+        memcpy(cp->params, sj->params, sizeof cp->params);
+        cp->map_size = maps[k];
+        cp->params[ms] = maps[k];
+        Error refusal;
+        if (penumbra_error(o, lab, sj->t, cp, &refusal)) {
+            n++;
+        } else if (!note[0]) {
+            char why[1100];
+            snprintf(why, sizeof why, "map_size %d REFUSED (%s)", maps[k], refusal.msg);
+            bench_csv_field(note, sizeof note, why);
+            /* no comma: report.sh's plots split matched_curve.csv on commas */
+            snprintf(curve_note, sizeof curve_note, "map_size %d REFUSED (matched.csv says why)", maps[k]);
+            printf("  %-18s map_size %d REFUSED (%s)\n", sj->t->name, maps[k], refusal.msg);
+        }
+    }
+    if (ok && n == 0) ok = error_set(err, "%s refused every map size", sj->t->name);
+    if (ok) {
+        target = &c[n];
+        memcpy(target->params, base.params, sizeof target->params);
+        target->map_size = (int)base.params[tech_param_index(pcss, "map_size")];
+        ok = penumbra_error(o, lab, pcss, target, err);
+    }
+    if (ok) announce(o, sj, "matched");
+    for (int r = 0; ok && r < rounds; r++)
+        for (int k = 0; ok && k <= n; k++) {
+            Point p;
+            ok = measure(lab, k < n ? sj->t : pcss, c[k].params, 1, &p, err);
+            c[k].frame[r] = p.frame_s;
+            c[k].eval[r] = p.eval_s;
+        }
+    if (ok) where(sj, lab_scene(lab), o->c.threads, end, sizeof end);
+    for (int k = 0; ok && k < n; k++) {
+        char row[4096];
+        double f = bench_median(c[k].frame, rounds), e = bench_median(c[k].eval, rounds);
+        snprintf(row, sizeof row, "%s,%d,%.6f,%.6f,%ld,%.4f,%.4f,%s,%s", sj->t->name, c[k].map_size, c[k].rmse,
+                 c[k].noise_rms, c[k].samples, f * 1e3, e * 1e3, k == 0 ? curve_note : "", end);
+        printf("  %-18s map_size %4d: penumbra RMSE %.5f (reference noise %.5f, %ld samples), frame %9.3f ms\n",
+               sj->t->name, c[k].map_size, c[k].rmse, c[k].noise_rms, c[k].samples, f * 1e3);
+        ok = append(o, "matched_curve.csv", CURVE_HEADER, row, err);
+    }
+    if (ok) {
+        double ratio[64], at[64];
+        const char *how = "no";
+        for (int r = 0; r < rounds; r++) {
+            at[r] = time_at_rmse(c, n, r, target->rmse, &how);
+            ratio[r] = at[r] / target->frame[r];
+        }
+        double pcss_ms = bench_median(target->frame, rounds) * 1e3;
+        double at_ms = bench_median(at, rounds) * 1e3, rt = bench_median(ratio, rounds);
+        char row[4096];
+        snprintf(row, sizeof row, "%s,%.6f,%.4f,%.4f,%.3f,%s,%s,%s", sj->t->name, target->rmse, pcss_ms, at_ms, rt,
+                 how, note, end);
+        printf("  %-18s at pcss's penumbra RMSE %.5f (pcss %d^2, %.3f ms): %s%.3f ms, ratio %.3f\n", sj->t->name,
+               target->rmse, target->map_size, pcss_ms,
+               strcmp(how, "no") == 0 ? "NOT REACHED by any map size, " : strcmp(how, "at_first_point") == 0
+                                                                           ? "below it already at 256^2 (an upper bound), "
+                                                                           : "",
+               at_ms, rt);
+        ok = append(o, "matched.csv", MATCHED_HEADER, row, err);
+    }
+    free(c);
+    lab_close(lab);
+    return ok;
+}
+
 /* ---- thread scaling ------------------------------------------------------------ */
 
 typedef struct Scaling {
@@ -571,6 +845,10 @@ static bool bench_technique(const Options *o, const Technique *t)
     if (ok && part(o, "threads")) ok = scaling(o, &sj, &err);
     if (ok && part(o, "lightsize") && soft_on_spheres(t)) ok = light_size(o, &sj, &err);
     if (ok && part(o, "work")) ok = work_counts(o, &sj, &err);
+    if (ok && o->only && strcmp(o->only, "sweep") == 0 && (sweep_on_scene(o) || tech_param_index(t, o->axis) >= 0))
+        ok = sweep_cost(o, &sj, &err);
+    if (ok && o->only && strcmp(o->only, "matched") == 0 && (o->num_techs > 0 || in_matched_family(t->name)))
+        ok = matched(o, &sj, &err);
     if (sj.refused) printf("%s: %d growth point(s) REFUSED (growth.csv's note column says why)\n", t->name, sj.refused);
     if (!ok) fprintf(stderr, "techniques: %s: FAILED: %s\n", t->name, err.msg);
     return ok;
@@ -580,8 +858,9 @@ int main(int argc, char **argv)
 {
     Options o;
     if (!parse_options(argc, argv, &o))
-        return bench_usage("techniques [--only growth|constant|threads|lightsize|work] [-t TECH]... [-p NAME=VALUE]... "
-                           "[--threads N] [--repeat R] [--quick] [-o DIR] [SCENE]");
+        return bench_usage("techniques [--only growth|constant|threads|lightsize|work|sweep|matched] [-t TECH]... "
+                           "[-p NAME=VALUE]... [--sweep NAME=V1,V2,...] [--samples N] [--threads N] [--repeat R] "
+                           "[--quick] [-o DIR] [SCENE]");
     omp_set_num_threads(o.c.threads);
     rt_set_threads(o.c.threads);
     int failed = 0, run = 0;
