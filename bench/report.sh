@@ -243,7 +243,7 @@ plot x with lines dashtype 2 title 'ideal'"
     echo "The frame time each needs at pcss's penumbra RMSE (pcss at its defaults), over pcss's (reached: interpolated"
     echo "in log-log on the curve, at_first_point: already below it at 256^2, an upper bound; no: not reached):"
     echo
-    table matched.csv technique scene target_rmse pcss_frame_ms frame_at_target_ms ratio reached note threads load_1min
+    table matched.csv technique scene target_rmse pcss_frame_ms frame_at_target_ms ratio pcss_eval_ms eval_at_target_ms eval_ratio reached note threads load_1min
 } > "$md"
 plots
 echo "report: $md"

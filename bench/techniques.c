@@ -56,10 +56,12 @@
 #define LIGHT_SMALL 0.05 /* light 1's radii of the lightsize part, world units */
 #define LIGHT_LARGE 0.8
 #define SWEEP_HEADER "technique,axis,value,frame_ms,eval_ms,lit_candidates,eval_ns_per_sample," \
-                     "eval_ns_per_sample_per_value,frame_ratio,eval_ratio,frame_per_value_ratio,per_value_ratio," WHERE_HEADER
+                     "eval_ns_per_sample_per_value,frame_ratio,eval_ratio,frame_per_value_ratio,per_value_ratio," \
+                     WHERE_HEADER
 #define CURVE_HEADER "technique,map_size,penumbra_rmse,penumbra_noise_rms,penumbra_samples,frame_ms,eval_ms,note," \
                      WHERE_HEADER
-#define MATCHED_HEADER "technique,target_rmse,pcss_frame_ms,frame_at_target_ms,ratio,reached,note," WHERE_HEADER
+#define MATCHED_HEADER "technique,target_rmse,pcss_frame_ms,frame_at_target_ms,ratio,pcss_eval_ms,eval_at_target_ms," \
+                       "eval_ratio,reached,note," WHERE_HEADER
 #define WORK_HEADER "technique,lit_candidates,texel_fetches_per_sample,texel_bytes_per_sample,rays_per_sample," \
                     "frame_triangles,frame_fragments,frame_texel_fetches,frame_rays,frame_bytes_built,hand_rule," \
                     "hand_texel_fetches_per_sample,hand_rays_per_sample,agrees," WHERE_HEADER
@@ -532,8 +534,8 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
         double fr = round_ratio(frame, rounds, n, k, 1.0), er = round_ratio(eval, rounds, n, k, 1.0);
         /* per lit candidate per unit, over the first value's: the lit counts
          * differ with a scene key (a light's size moves the shadow) */
-        double scale = lit[0] > 0 && lit[k] > 0 && o->values[k] != 0.0
-                           ? (double)lit[0] / (double)lit[k] * o->values[0] / o->values[k] : NAN;
+        double scale = lit[0] > 0 && lit[k] > 0 && o->values[0] != 0.0 && o->values[k] != 0.0
+                           ? (double)lit[0] / (double)lit[k] * o->values[0] / o->values[k] : NAN; /* a 0: no unit */
         double pvr = round_ratio(eval, rounds, n, k, scale), fpvr = round_ratio(frame, rounds, n, k, scale);
         char row[4096], end[1024];
         where(sj, lab_scene(labs[k]), o->c.threads, end, sizeof end);
@@ -591,26 +593,34 @@ static bool penumbra_error(const Options *o, Lab *lab, const Technique *t, Curve
     return true;
 }
 
-/* The frame time at RMSE `target` on a curve in order of map size, in one
- * round: log-log interpolation on the first segment that brackets it; the
+/* The frame (eval: evaluation) time at RMSE `target` on a curve in order of
+ * map size, in one round: log-log interpolation on the first segment that brackets it; the
  * first point's time where that point is already at or below it (an upper
  * bound); NaN where no point reaches it. *how says which. */
-static double time_at_rmse(const CurvePoint *c, int n, int round, double target, const char **how)
+static double time_at_rmse(const CurvePoint *c, int n, int round, bool eval, double target, const char **how)
 {
     *how = "no";
     if (n > 0 && c[0].rmse <= target) {
         *how = "at_first_point";
-        return c[0].frame[round];
+        return eval ? c[0].eval[round] : c[0].frame[round];
     }
     for (int k = 0; k + 1 < n; k++) {
         double ra = c[k].rmse, rb = c[k + 1].rmse;
         if (!(ra > target && rb <= target)) continue; /* NaN rmse: not a bracket */
         *how = "interpolated";
-        double ta = c[k].frame[round], tb = c[k + 1].frame[round];
+        double ta = eval ? c[k].eval[round] : c[k].frame[round];
+        double tb = eval ? c[k + 1].eval[round] : c[k + 1].frame[round];
         double u = ra == rb ? 0.0 : (log(target) - log(ra)) / (log(rb) - log(ra)); /* ra > target >= rb > 0 */
         return exp(log(ta) + u * (log(tb) - log(ta)));
     }
     return NAN;
+}
+
+/* time_at_rmse's answer, as printed before the times. */
+static const char *reach_text(const char *how)
+{
+    if (strcmp(how, "no") == 0) return "NOT REACHED by any map size, ";
+    return strcmp(how, "at_first_point") == 0 ? "below it already at 256^2 (an upper bound), " : "";
 }
 
 /* The subject's curve over map sizes 256 ... 2048 (--quick: ... 1024) and
@@ -679,23 +689,24 @@ static bool matched(const Options *o, Subject *sj, Error *err)
         ok = append(o, "matched_curve.csv", CURVE_HEADER, row, err);
     }
     if (ok) {
-        double ratio[64], at[64];
+        double ratio[2][64], at[2][64]; /* frame, evaluation */
         const char *how = "no";
-        for (int r = 0; r < rounds; r++) {
-            at[r] = time_at_rmse(c, n, r, target->rmse, &how);
-            ratio[r] = at[r] / target->frame[r];
-        }
+        for (int r = 0; r < rounds; r++)
+            for (int e = 0; e < 2; e++) {
+                at[e][r] = time_at_rmse(c, n, r, e, target->rmse, &how);
+                ratio[e][r] = at[e][r] / (e ? target->eval[r] : target->frame[r]);
+            }
         double pcss_ms = bench_median(target->frame, rounds) * 1e3;
-        double at_ms = bench_median(at, rounds) * 1e3, rt = bench_median(ratio, rounds);
+        double pcss_eval_ms = bench_median(target->eval, rounds) * 1e3;
+        double at_ms = bench_median(at[0], rounds) * 1e3, rt = bench_median(ratio[0], rounds);
+        double at_eval_ms = bench_median(at[1], rounds) * 1e3, rt_eval = bench_median(ratio[1], rounds);
         char row[4096];
-        snprintf(row, sizeof row, "%s,%.6f,%.4f,%.4f,%.3f,%s,%s,%s", sj->t->name, target->rmse, pcss_ms, at_ms, rt,
-                 how, note, end);
-        printf("  %-18s at pcss's penumbra RMSE %.5f (pcss %d^2, %.3f ms): %s%.3f ms, ratio %.3f\n", sj->t->name,
-               target->rmse, target->map_size, pcss_ms,
-               strcmp(how, "no") == 0 ? "NOT REACHED by any map size, " : strcmp(how, "at_first_point") == 0
-                                                                           ? "below it already at 256^2 (an upper bound), "
-                                                                           : "",
-               at_ms, rt);
+        snprintf(row, sizeof row, "%s,%.6f,%.4f,%.4f,%.3f,%.4f,%.4f,%.3f,%s,%s,%s", sj->t->name, target->rmse, pcss_ms,
+                 at_ms, rt, pcss_eval_ms, at_eval_ms, rt_eval, how, note, end);
+        printf("  %-18s at pcss's penumbra RMSE %.5f (pcss %d^2, frame %.3f ms, eval %.3f ms): %sframe %.3f ms, "
+               "ratio %.3f; eval %.3f ms, ratio %.3f\n", sj->t->name, target->rmse, target->map_size, pcss_ms,
+               pcss_eval_ms,
+               reach_text(how), at_ms, rt, at_eval_ms, rt_eval);
         ok = append(o, "matched.csv", MATCHED_HEADER, row, err);
     }
     free(c);
