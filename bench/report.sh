@@ -116,7 +116,7 @@ plot 1 with lines dashtype 2 title 'linear'"
     fi
     if [ -f "$dir/matched_curve.csv" ]; then
         for s in $(column "$dir/matched_curve.csv" scene | sort -u); do
-            script="set title 'Penumbra RMSE against frame time, $s (map sizes 256 ... 2048)'
+            script="set title 'Penumbra RMSE against frame time, $s (map sizes 64 ... 2048)'
 set xlabel 'frame time (ms)'; set ylabel 'penumbra RMSE'; set logscale xy; set grid; set key outside right noenhanced
 plot "
             first=1
@@ -196,9 +196,10 @@ plot x with lines dashtype 2 title 'ideal'"
     echo "Constant in the light's size (the prefiltered PCSS family and occlusion textures claim it; pcss grows):"
     echo
     table light_size.csv technique map_size radius_small radius_large frame_small_ms frame_large_ms ratio within scene threads load_1min
-    echo "Where a technique refused the asked map size (its own cap), the size it was measured at and why:"
+    echo "The same rows' evaluation times (the two radii alternate in every round; a frame also carries its map's build,"
+    echo "timed once when built), and where a technique refused the asked map size (its own cap), why:"
     echo
-    table light_size.csv technique map_size settings note
+    table light_size.csv technique map_size settings eval_small_ms eval_large_ms eval_ratio note
     echo "Machine-independent work per technique (core/counters.h), beside the hand count where one is known:"
     echo
     table work.csv technique texel_fetches_per_sample rays_per_sample frame_triangles frame_fragments frame_bytes_built hand_rule agrees light
@@ -241,7 +242,7 @@ plot x with lines dashtype 2 title 'ideal'"
     echo
     table matched_curve.csv technique scene map_size penumbra_rmse penumbra_noise_rms penumbra_samples frame_ms eval_ms note threads load_1min
     echo "The frame time each needs at pcss's penumbra RMSE (pcss at its defaults), over pcss's (reached: interpolated"
-    echo "in log-log on the curve, at_first_point: already below it at 256^2, an upper bound; no: not reached):"
+    echo "in log-log on the curve, at_first_point: already below it at 64^2, an upper bound; no: not reached):"
     echo
     table matched.csv technique scene target_rmse pcss_frame_ms frame_at_target_ms ratio pcss_eval_ms eval_at_target_ms eval_ratio reached note threads load_1min
 } > "$md"

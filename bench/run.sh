@@ -96,7 +96,7 @@ run "$bin/techniques" --only sweep -t backprojection -p budget=256 --sweep 'ligh
     $sweep_map --threads "$threads" --repeat "$repeat" -o "$out"
 run "$bin/techniques" --only sweep -t backprojection --sweep accumulate=0,1 $sweep_map --threads "$threads" \
     --repeat "$repeat" -o "$out"
-# the prefiltered PCSS family against pcss at pcss's penumbra RMSE (map sizes 256 ... 2048; QUICK: ... 1024, 160x120)
+# the prefiltered PCSS family against pcss at pcss's penumbra RMSE (map sizes 64 ... 2048; QUICK: ... 1024, 160x120)
 for s in scenes/bunny.lua scenes/sphere-on-plane.lua scenes/overlap.lua; do
     run "$bin/techniques" --only matched $q --samples "$samples" --threads "$threads" --repeat "$repeat" -o "$out" "$s"
 done

@@ -16,8 +16,9 @@
  *     curve 1, 2, 4, ... N threads (bench.h's BenchCurve);
  *   lightsize: every soft technique that handles sphere lights at light 1's
  *     radius 0.05 and 0.8 (map_size 2048 where it has one; --quick: 1024;
- *     -p map_size=N: N; where it refuses that size, the largest half it accepts):
- *     frame time at 0.8 over 0.05, against the 1.2 bound the constant-time
+ *     -p map_size=N: N; where it refuses that size, the largest half it accepts),
+ *     the two radii in two Labs timed alternately in every round: frame (and
+ *     evaluation) time at 0.8 over 0.05, against the 1.2 bound the constant-time
  *     claims name (prefiltered PCSS, CSSM, VSSM, ESSM, moment soft shadows:
  *     course §5.2.2; occlusion textures: §5.2.5), `pcss` beside them growing;
  *   work: each technique's machine-independent work counters (core/counters.h:
@@ -52,7 +53,7 @@
 #define CONSTANT_HEADER "technique,prefilter,K_min,K_max,frame_min_ms,frame_max_ms,ratio,bound,within," WHERE_HEADER
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup," WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
-                          "note," WHERE_HEADER
+                          "eval_small_ms,eval_large_ms,eval_ratio,note," WHERE_HEADER
 #define LIGHT_SMALL 0.05 /* light 1's radii of the lightsize part, world units */
 #define LIGHT_LARGE 0.8
 #define SWEEP_HEADER "technique,axis,value,frame_ms,eval_ms,lit_candidates,eval_ns_per_sample," \
@@ -395,85 +396,6 @@ static bool constant_time(const Options *o, Subject *sj, Error *err)
     return append(o, "constant_time.csv", CONSTANT_HEADER, row, err);
 }
 
-/* ---- constant in the light's size -------------------------------------------- */
-
-static bool soft_on_spheres(const Technique *t)
-{
-    return strcmp(t->family, "soft") == 0 && (t->lights & LIGHT_BIT(LIGHT_SPHERE));
-}
-
-/* Frame time at one radius of light 1 (a sphere on the bench's scenes). */
-static bool at_radius(const Options *o, Subject *sj, const double *params, double radius, Point *p, char *end,
-                      size_t n, Error *err)
-{
-    char r[64];
-    snprintf(r, sizeof r, "lights[1].radius=%g", radius);
-    const char *ov[] = {"camera.width=320", "camera.height=240", r};
-    Lab *lab = open_lab(o, sj, ov, 3, err);
-    if (!lab) return false;
-    bool ok = measure(lab, sj->t, params, o->c.repeat, p, err);
-    if (ok && end) where(sj, lab_scene(lab), o->c.threads, end, n);
-    lab_close(lab);
-    return ok;
-}
-
-/* Whether -p assigned the parameter `name` (a part then leaves it as given). */
-static bool assigned(const Options *o, const char *name)
-{
-    for (int i = 0; i < o->num_settings; i++)
-        if (strcmp(param_name(o->settings[i]).s, name) == 0) return true;
-    return false;
-}
-
-/* Frame times at both radii at map_size `map_size` (0: the technique has none). */
-static bool both_radii(const Options *o, Subject *sj, int map_size, Point *lo, Point *hi, char *end, size_t n,
-                       Error *err)
-{
-    double params[TECH_MAX_PARAMS];
-    memcpy(params, sj->params, sizeof params);
-    int ms = tech_param_index(sj->t, "map_size");
-    if (ms >= 0) params[ms] = map_size;
-    return at_radius(o, sj, params, LIGHT_SMALL, lo, NULL, 0, err) &&
-           at_radius(o, sj, params, LIGHT_LARGE, hi, end, n, err);
-}
-
-/* At map_size 2048 (--quick: 1024; -p map_size=N: N), or, where the technique
- * refuses that with its own error (a resource over its cap), at the first of
- * half, a quarter, ... (down to 256) it accepts, as memory.c does; the row's
- * note names the size refused and why. Only a technique that refuses every
- * size (or has no map_size and refuses) fails. */
-static bool light_size(const Options *o, Subject *sj, Error *err)
-{
-    const Technique *t = sj->t;
-    int ms = tech_param_index(t, "map_size");
-    int map_size = ms < 0 ? 0 : assigned(o, "map_size") ? (int)sj->params[ms] : o->quick ? 1024 : 2048;
-    Point lo, hi;
-    char end[1024], note[1200] = "";
-    while (!both_radii(o, sj, map_size, &lo, &hi, end, sizeof end, err)) {
-        if (ms < 0 || map_size / 2 < 256) return false;
-        if (!note[0]) {
-            char why[1100];
-            snprintf(why, sizeof why, "map_size %d REFUSED (%s); measured at the largest half accepted", map_size,
-                     err->msg);
-            bench_csv_field(note, sizeof note, why);
-        }
-        printf("  %-18s map_size %d REFUSED (%s); trying %d\n", t->name, map_size, err->msg, map_size / 2);
-        map_size /= 2;
-    }
-    announce(o, sj, "lightsize");
-    double ratio = hi.frame_s / lo.frame_s;
-    char row[4096];
-    snprintf(row, sizeof row, "%s,%d,%g,%g,%.4f,%.4f,%.3f,%.1f,%s,%s,%s", t->name, map_size, LIGHT_SMALL, LIGHT_LARGE,
-             lo.frame_s * 1e3, hi.frame_s * 1e3, ratio, CONSTANT_BOUND, ratio <= CONSTANT_BOUND ? "yes" : "no", note,
-             end);
-    printf("  %-18s map_size %d: radius %g: %.3f ms, radius %g: %.3f ms, ratio %.2f (bound %.1f)%s\n", t->name,
-           map_size, LIGHT_SMALL, lo.frame_s * 1e3, LIGHT_LARGE, hi.frame_s * 1e3, ratio, CONSTANT_BOUND,
-           ratio <= CONSTANT_BOUND ? "" : "  OVER");
-    return append(o, "light_size.csv", LIGHT_SIZE_HEADER, row, err);
-}
-
-/* ---- cost against one axis (--sweep) ---------------------------------------- */
-
 /* Median over rounds of point k's per-round time over point 0's, times
  * scale (t[r * n + k]: round r, point k). */
 static double round_ratio(const double *t, int rounds, int n, int k, double scale)
@@ -490,6 +412,115 @@ static double round_median(const double *t, int rounds, int n, int k)
     for (int r = 0; r < rounds; r++) v[r] = t[r * n + k];
     return bench_median(v, rounds);
 }
+
+/* Every round times each of n configurations (labs[k], params[k]) once, in
+ * order, each after measure's own untimed warm-up: frame and evaluation
+ * seconds in frame[r * n + k], eval[r * n + k]; lit[k] its lit candidates. */
+static bool timed_rounds(Lab *const *labs, const Technique *t, double (*params)[TECH_MAX_PARAMS], int n, int rounds,
+                         double *frame, double *eval, long *lit, Error *err)
+{
+    for (int r = 0; r < rounds; r++)
+        for (int k = 0; k < n; k++) {
+            Point p;
+            if (!measure(labs[k], t, params[k], 1, &p, err)) return false;
+            frame[r * n + k] = p.frame_s;
+            eval[r * n + k] = p.eval_s;
+            lit[k] = p.lit;
+        }
+    return true;
+}
+
+/* ---- constant in the light's size -------------------------------------------- */
+
+static bool soft_on_spheres(const Technique *t)
+{
+    return strcmp(t->family, "soft") == 0 && (t->lights & LIGHT_BIT(LIGHT_SPHERE));
+}
+
+/* Whether -p assigned the parameter `name` (a part then leaves it as given). */
+static bool assigned(const Options *o, const char *name)
+{
+    for (int i = 0; i < o->num_settings; i++)
+        if (strcmp(param_name(o->settings[i]).s, name) == 0) return true;
+    return false;
+}
+
+/* The two radii's times at map_size `map_size` (0: the technique has none),
+ * one Lab each, alternating in every round (timed_rounds): medians in
+ * frame_ms[2], eval_ms[2]; *frame_ratio, *eval_ratio the medians of the
+ * per-round ratios large / small. */
+typedef struct RadiusPair {
+    double frame_ms[2], eval_ms[2], frame_ratio, eval_ratio;
+} RadiusPair;
+
+static bool both_radii(const Options *o, Subject *sj, int map_size, RadiusPair *rp, char *end, size_t n, Error *err)
+{
+    static const double radii[2] = {LIGHT_SMALL, LIGHT_LARGE};
+    int rounds = o->c.repeat > 64 ? 64 : o->c.repeat, ms = tech_param_index(sj->t, "map_size");
+    double params[2][TECH_MAX_PARAMS], frame[2 * 64], eval[2 * 64];
+    long lit[2];
+    Lab *labs[2] = {NULL, NULL};
+    bool ok = true;
+    for (int k = 0; ok && k < 2; k++) {
+        memcpy(params[k], sj->params, sizeof params[k]);
+        if (ms >= 0) params[k][ms] = map_size;
+        char r[64];
+        snprintf(r, sizeof r, "lights[1].radius=%g", radii[k]);
+        const char *ov[] = {"camera.width=320", "camera.height=240", r};
+        ok = (labs[k] = open_lab(o, sj, ov, 3, err)) != NULL;
+    }
+    ok = ok && timed_rounds(labs, sj->t, params, 2, rounds, frame, eval, lit, err);
+    if (ok) {
+        where(sj, lab_scene(labs[1]), o->c.threads, end, n);
+        for (int k = 0; k < 2; k++) {
+            rp->frame_ms[k] = round_median(frame, rounds, 2, k) * 1e3;
+            rp->eval_ms[k] = round_median(eval, rounds, 2, k) * 1e3;
+        }
+        rp->frame_ratio = round_ratio(frame, rounds, 2, 1, 1.0);
+        rp->eval_ratio = round_ratio(eval, rounds, 2, 1, 1.0);
+    }
+    lab_close(labs[0]);
+    lab_close(labs[1]);
+    return ok;
+}
+
+/* At map_size 2048 (--quick: 1024; -p map_size=N: N), or, where the technique
+ * refuses that with its own error (a resource over its cap), at the first of
+ * half, a quarter, ... (down to 256) it accepts, as memory.c does; the row's
+ * note names the size refused and why. Only a technique that refuses every
+ * size (or has no map_size and refuses) fails. */
+static bool light_size(const Options *o, Subject *sj, Error *err)
+{
+    const Technique *t = sj->t;
+    int ms = tech_param_index(t, "map_size");
+    int map_size = ms < 0 ? 0 : assigned(o, "map_size") ? (int)sj->params[ms] : o->quick ? 1024 : 2048;
+    RadiusPair rp;
+    char end[1024], note[1200] = "";
+    while (!both_radii(o, sj, map_size, &rp, end, sizeof end, err)) {
+        if (ms < 0 || map_size / 2 < 256) return false;
+        if (!note[0]) {
+            char why[1100];
+            snprintf(why, sizeof why, "map_size %d REFUSED (%s); measured at the largest half accepted", map_size,
+                     err->msg);
+            bench_csv_field(note, sizeof note, why);
+        }
+        printf("  %-18s map_size %d REFUSED (%s); trying %d\n", t->name, map_size, err->msg, map_size / 2);
+        map_size /= 2;
+    }
+    announce(o, sj, "lightsize");
+    double ratio = rp.frame_ratio;
+    char row[4096];
+    snprintf(row, sizeof row, "%s,%d,%g,%g,%.4f,%.4f,%.3f,%.1f,%s,%.4f,%.4f,%.3f,%s,%s", t->name, map_size,
+             LIGHT_SMALL, LIGHT_LARGE, rp.frame_ms[0], rp.frame_ms[1], ratio, CONSTANT_BOUND,
+             ratio <= CONSTANT_BOUND ? "yes" : "no", rp.eval_ms[0], rp.eval_ms[1], rp.eval_ratio, note, end);
+    printf("  %-18s map_size %d: radius %g: frame %.3f ms (eval %.3f), radius %g: frame %.3f ms (eval %.3f), "
+           "ratio %.2f (bound %.1f; eval %.2f)%s\n", t->name, map_size, LIGHT_SMALL, rp.frame_ms[0], rp.eval_ms[0],
+           LIGHT_LARGE, rp.frame_ms[1], rp.eval_ms[1], ratio, CONSTANT_BOUND, rp.eval_ratio,
+           ratio <= CONSTANT_BOUND ? "" : "  OVER");
+    return append(o, "light_size.csv", LIGHT_SIZE_HEADER, row, err);
+}
+
+/* ---- cost against one axis (--sweep) ---------------------------------------- */
 
 /* The subject at every value of the --sweep axis (320 x 240): a parameter in
  * one Lab, a scene key in one Lab per value. Every round times each value
@@ -519,14 +550,7 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
         ok = (labs[k] = open_lab(o, sj, ov, pi >= 0 ? 2 : 3, err)) != NULL;
     }
     if (ok) announce(o, sj, "sweep");
-    for (int r = 0; ok && r < rounds; r++)
-        for (int k = 0; ok && k < n; k++) {
-            Point p;
-            ok = measure(labs[k], sj->t, params[k], 1, &p, err);
-            frame[r * n + k] = p.frame_s;
-            eval[r * n + k] = p.eval_s;
-            lit[k] = p.lit;
-        }
+    ok = ok && timed_rounds(labs, sj->t, params, n, rounds, frame, eval, lit, err);
     for (int k = 0; ok && k < n; k++) {
         double f = round_median(frame, rounds, n, k), e = round_median(eval, rounds, n, k);
         double per_sample = lit[k] > 0 ? e * 1e9 / (double)lit[k] : NAN; /* no lit candidate: NaN, shown */
@@ -554,6 +578,7 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
 /* ---- error against time at pcss's penumbra RMSE (issue 16) -------------------- */
 
 /* The prefiltered PCSS family of course §5.2.2 that issue 16 sets against pcss. */
+#define MATCHED_SMALLEST_MAP 64 /* texels per side */
 static const char *const matched_family[] = {"pcss", "pcss_prefiltered", "cssm", "vssm", "essm",
                                              "evssm", "moment_soft", "dpcf"};
 
@@ -620,10 +645,10 @@ static double time_at_rmse(const CurvePoint *c, int n, int round, bool eval, dou
 static const char *reach_text(const char *how)
 {
     if (strcmp(how, "no") == 0) return "NOT REACHED by any map size, ";
-    return strcmp(how, "at_first_point") == 0 ? "below it already at 256^2 (an upper bound), " : "";
+    return strcmp(how, "at_first_point") == 0 ? "below it already at its smallest map (an upper bound), " : "";
 }
 
-/* The subject's curve over map sizes 256 ... 2048 (--quick: ... 1024) and
+/* The subject's curve over map sizes 64 ... 2048 (--quick: ... 1024) and
  * pcss at its defaults (the target: its penumbra RMSE and frame time), in
  * one Lab at 240 x 180 (--quick: 160 x 120), timed alternately in every
  * round; the time the subject needs at pcss's RMSE over pcss's time is the
@@ -631,8 +656,8 @@ static const char *reach_text(const char *how)
  * and left out of the curve. */
 static bool matched(const Options *o, Subject *sj, Error *err)
 {
-    static const int maps[] = {256, 512, 1024, 2048};
-    int nmaps = o->quick ? 3 : 4, rounds = o->c.repeat > 64 ? 64 : o->c.repeat;
+    static const int maps[] = {MATCHED_SMALLEST_MAP, 128, 256, 512, 1024, 2048};
+    int nmaps = o->quick ? 5 : 6, rounds = o->c.repeat > 64 ? 64 : o->c.repeat;
     const char *ov[] = {o->quick ? "camera.width=160" : "camera.width=240",
                         o->quick ? "camera.height=120" : "camera.height=180"};
     Subject base;
