@@ -109,7 +109,8 @@ plot 1 with lines dashtype 2 title 'linear'"
         for ta in $(column "$dir/sweep.csv" technique axis | tr ' ' '@' | sort -u); do
             t=${ta%%@*} a=${ta#*@} d="$dir/sweep_$(printf '%s' "$ta" | tr -c 'A-Za-z0-9_\n' '_').dat"
             column "$dir/sweep.csv" technique axis value per_value_ratio |
-                awk -v t="$t" -v a="$a" '$1 == t && $2 == a { print $3, $4 }' > "$d"
+                awk -v t="$t" -v a="$a" '$1 == t && $2 == a && $3 ~ /^[-+.0-9eE]+$/ && $4 != "nan" { print $3, $4 }' > "$d"
+            [ -s "$d" ] || { rm -f "$d"; continue; } # an enum's choices, or a 0: no per-unit figure
             script="$script, '$d' using 1:2 with linespoints title '$t, $a'"
         done
         plot sweep "$script"

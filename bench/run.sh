@@ -94,7 +94,7 @@ run "$bin/techniques" --only sweep -t backprojection --sweep budget=2,4,8,16,32,
     --repeat "$repeat" -o "$out"
 run "$bin/techniques" --only sweep -t backprojection -p budget=256 --sweep 'lights[1].radius=0.05,0.1,0.2,0.4,0.8' \
     $sweep_map --threads "$threads" --repeat "$repeat" -o "$out"
-run "$bin/techniques" --only sweep -t backprojection --sweep accumulate=0,1 $sweep_map --threads "$threads" \
+run "$bin/techniques" --only sweep -t backprojection --sweep accumulate=bitmask,area $sweep_map --threads "$threads" \
     --repeat "$repeat" -o "$out"
 # the prefiltered PCSS family against pcss at pcss's penumbra RMSE (map sizes 64 ... 2048; QUICK: ... 1024, 160x120)
 for s in scenes/bunny.lua scenes/sphere-on-plane.lua scenes/overlap.lua; do

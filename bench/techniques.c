@@ -75,7 +75,8 @@ typedef struct Options {
     bool quick;
     const char *sweep; /* --sweep NAME=V1,V2,...: the sweep part's axis */
     char axis[128];    /* its NAME: a technique parameter, or a scene key (holds '.' or '[') */
-    double values[MAX_POINTS];
+    char value_text[MAX_POINTS][64]; /* its values as given: numbers, or an enum's choices */
+    double values[MAX_POINTS];        /* as numbers (NaN for a choice: no per-unit figures) */
     int num_values;
     int samples;       /* --samples N: the matched part's reference light samples */
 } Options;
@@ -131,35 +132,53 @@ static ParamName param_name(const char *assignment)
 /* Whether the --sweep axis is a scene key (lights[1].radius), not a parameter. */
 static bool sweep_on_scene(const Options *o) { return strchr(o->axis, '.') || strchr(o->axis, '['); }
 
-/* Whether a technique -t selects has the parameter -p assigns (a typo is refused). */
-static bool setting_used(const Options *o, const char *assignment)
+/* Whether a technique -t selects has the parameter `option` (-p, --sweep) assigns (a typo is refused). */
+static bool setting_used(const Options *o, const char *option, const char *assignment)
 {
     ParamName name = param_name(assignment);
     for (int i = 0; i < tech_count(); i++)
         if (wanted(o, tech_at(i)->name) && tech_param_index(tech_at(i), name.s) >= 0) return true;
-    fprintf(stderr, "techniques: -p %s: no selected technique has a parameter '%s'\n", assignment, name.s);
+    fprintf(stderr, "techniques: %s %s: no selected technique has a parameter '%s'\n", option, assignment, name.s);
     return false;
 }
 
-/* --sweep NAME=V1,V2,...: at most MAX_POINTS numbers, a scene key or a
- * parameter of a selected technique. */
+/* --sweep NAME=V1,V2,...: at most MAX_POINTS values, of a scene key or of a
+ * parameter of a selected technique (each value checked by every selected
+ * technique that has it: its range or choices named where one is refused). */
 static bool parse_sweep(Options *o)
 {
     snprintf(o->axis, sizeof o->axis, "%s", param_name(o->sweep).s);
-    const char *v = strchr(o->sweep, '=') + 1;
-    while (*v) {
-        char *end;
-        double x = strtod(v, &end);
-        if (end == v || !isfinite(x) || o->num_values == MAX_POINTS || (*end && *end != ',')) {
-            fprintf(stderr, "techniques: --sweep %s: expected NAME=V1,V2,... with at most %d finite numbers\n",
+    for (const char *v = strchr(o->sweep, '=') + 1; *v;) {
+        size_t len = strcspn(v, ",");
+        if (len == 0 || len >= sizeof o->value_text[0] || o->num_values == MAX_POINTS) {
+            fprintf(stderr, "techniques: --sweep %s: expected NAME=V1,V2,... with at most %d non-empty values\n",
                     o->sweep, MAX_POINTS);
             return false;
         }
-        o->values[o->num_values++] = x;
-        v = *end ? end + 1 : end;
+        char *text = o->value_text[o->num_values], *end;
+        snprintf(text, sizeof o->value_text[0], "%.*s", (int)len, v);
+        double x = strtod(text, &end);
+        o->values[o->num_values++] = *end == '\0' && isfinite(x) ? x : NAN;
+        v += len + (v[len] == ',');
     }
-    if (o->num_values == 0) return false;
-    return sweep_on_scene(o) || setting_used(o, o->sweep);
+    if (o->num_values == 0 || sweep_on_scene(o)) return o->num_values > 0;
+    if (!setting_used(o, "--sweep", o->sweep)) return false;
+    for (int i = 0; i < tech_count(); i++) {
+        const Technique *t = tech_at(i);
+        if (!wanted(o, t->name) || tech_param_index(t, o->axis) < 0) continue;
+        for (int k = 0; k < o->num_values; k++) {
+            double scratch[TECH_MAX_PARAMS];
+            char a[256];
+            Error err;
+            tech_params_default(t, scratch);
+            snprintf(a, sizeof a, "%s=%s", o->axis, o->value_text[k]);
+            if (!tech_param_parse(t, a, scratch, &err)) {
+                fprintf(stderr, "techniques: --sweep: %s: %s\n", t->name, err.msg);
+                return false;
+            }
+        }
+    }
+    return true;
 }
 
 static bool parse_options(int argc, char **argv, Options *o)
@@ -177,7 +196,7 @@ static bool parse_options(int argc, char **argv, Options *o)
         return false;
     }
     for (int i = 0; i < o->num_settings; i++)
-        if (!setting_used(o, o->settings[i])) return false;
+        if (!setting_used(o, "-p", o->settings[i])) return false;
     if (o->sweep && !parse_sweep(o)) return false;
     o->scene = o->c.num_scenes ? o->c.scenes[0] : "scenes/sphere-on-plane.lua";
     return true;
@@ -538,14 +557,14 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
     long lit[MAX_POINTS] = {0};
     bool ok = true;
     for (int k = 0; ok && k < n; k++) {
+        char key[256];
+        snprintf(key, sizeof key, "%s=%s", o->axis, o->value_text[k]);
         memcpy(params[k], sj->params, sizeof params[k]);
-        if (pi >= 0) params[k][pi] = o->values[k];
+        if (pi >= 0 && !(ok = tech_param_parse(sj->t, key, params[k], err))) break; /* parse_sweep checked it */
         if (k > 0 && pi >= 0) {
             labs[k] = labs[0];
             continue;
         }
-        char key[192];
-        snprintf(key, sizeof key, "%s=%.17g", o->axis, o->values[k]);
         const char *ov[] = {"camera.width=320", "camera.height=240", key};
         ok = (labs[k] = open_lab(o, sj, ov, pi >= 0 ? 2 : 3, err)) != NULL;
     }
@@ -554,7 +573,7 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
     for (int k = 0; ok && k < n; k++) {
         double f = round_median(frame, rounds, n, k), e = round_median(eval, rounds, n, k);
         double per_sample = lit[k] > 0 ? e * 1e9 / (double)lit[k] : NAN; /* no lit candidate: NaN, shown */
-        double per_value = o->values[k] != 0.0 ? per_sample / o->values[k] : NAN;
+        double per_value = o->values[k] != 0.0 ? per_sample / o->values[k] : NAN; /* a choice (NaN) or 0: no unit */
         double fr = round_ratio(frame, rounds, n, k, 1.0), er = round_ratio(eval, rounds, n, k, 1.0);
         /* per lit candidate per unit, over the first value's: the lit counts
          * differ with a scene key (a light's size moves the shadow) */
@@ -563,11 +582,11 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
         double pvr = round_ratio(eval, rounds, n, k, scale), fpvr = round_ratio(frame, rounds, n, k, scale);
         char row[4096], end[1024];
         where(sj, lab_scene(labs[k]), o->c.threads, end, sizeof end);
-        snprintf(row, sizeof row, "%s,%s,%g,%.4f,%.4f,%ld,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%s", sj->t->name, o->axis,
-                 o->values[k], f * 1e3, e * 1e3, lit[k], per_sample, per_value, fr, er, fpvr, pvr, end);
-        printf("  %-18s %s %-8g frame %9.3f ms, eval %9.3f ms, %9.2f ns per lit sample, %8.3f per unit; "
+        snprintf(row, sizeof row, "%s,%s,%s,%.4f,%.4f,%ld,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%s", sj->t->name, o->axis,
+                 o->value_text[k], f * 1e3, e * 1e3, lit[k], per_sample, per_value, fr, er, fpvr, pvr, end);
+        printf("  %-18s %s %-8s frame %9.3f ms, eval %9.3f ms, %9.2f ns per lit sample, %8.3f per unit; "
                "ratios to the first: frame %.3f, eval %.3f, per sample per unit: frame %.3f, eval %.3f\n",
-               sj->t->name, o->axis, o->values[k], f * 1e3, e * 1e3, per_sample, per_value, fr, er, fpvr, pvr);
+               sj->t->name, o->axis, o->value_text[k], f * 1e3, e * 1e3, per_sample, per_value, fr, er, fpvr, pvr);
         ok = append(o, "sweep.csv", SWEEP_HEADER, row, err);
     }
     for (int k = 0; k < n; k++)
