@@ -198,9 +198,10 @@ plot x with lines dashtype 2 title 'ideal'"
     echo
     table light_size.csv technique map_size radius_small radius_large frame_small_ms frame_large_ms ratio within scene threads load_1min
     echo "The same rows' evaluation times (the two radii alternate in every round; a frame also carries its map's build,"
-    echo "timed once when built), and where a technique refused the asked map size (its own cap), why:"
+    echo "timed once when built), the texel bytes read per lit candidate (core/counters.h: what the early outs and"
+    echo "subdivisions leave to read), and where a technique refused the asked map size (its own cap), why:"
     echo
-    table light_size.csv technique map_size settings eval_small_ms eval_large_ms eval_ratio note
+    table light_size.csv technique map_size settings eval_small_ms eval_large_ms eval_ratio bytes_small bytes_large bytes_ratio note
     echo "Machine-independent work per technique (core/counters.h), beside the hand count where one is known:"
     echo
     table work.csv technique texel_fetches_per_sample rays_per_sample frame_triangles frame_fragments frame_bytes_built hand_rule agrees light

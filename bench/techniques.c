@@ -53,7 +53,8 @@
 #define CONSTANT_HEADER "technique,prefilter,K_min,K_max,frame_min_ms,frame_max_ms,ratio,bound,within," WHERE_HEADER
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup," WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
-                          "eval_small_ms,eval_large_ms,eval_ratio,note," WHERE_HEADER
+                          "eval_small_ms,eval_large_ms,eval_ratio,bytes_small,bytes_large,bytes_ratio,note," \
+                          WHERE_HEADER
 #define LIGHT_SMALL 0.05 /* light 1's radii of the lightsize part, world units */
 #define LIGHT_LARGE 0.8
 #define SWEEP_HEADER "technique,axis,value,frame_ms,eval_ms,lit_candidates,eval_ns_per_sample," \
@@ -95,6 +96,7 @@ typedef struct Point {
     double frame_s, eval_s, build_s;
     int built;
     long lit; /* lit candidates evaluated (what per-sample costs divide by) */
+    double bytes_per_lit; /* texel bytes one evaluation read per lit candidate (core/counters.h) */
 } Point;
 
 static int own_option(void *options, const char *a, const char *v)
@@ -259,7 +261,9 @@ static bool measure(Lab *lab, const Technique *t, const double *params, int repe
     RenderTiming timing = {.warmup = 1, .budget_s = 0.0};
     RenderResult r;
     if (!lab_render_timed(lab, &req, &timing, &r, err)) return false;
-    *p = (Point){r.frame_s, r.eval_median_s, r.tech_build_s, 0, r.lit_candidates};
+    double lit = r.lit_candidates > 0 ? (double)r.lit_candidates : NAN; /* none lit: NaN, shown */
+    *p = (Point){r.frame_s, r.eval_median_s, r.tech_build_s, 0, r.lit_candidates,
+                 (double)r.eval_work.texel_bytes / lit};
     for (int i = 0; i < r.num_tech_resources; i++) p->built += r.tech_resources[i].built;
     render_result_free(&r);
     return true;
@@ -434,17 +438,17 @@ static double round_median(const double *t, int rounds, int n, int k)
 
 /* Every round times each of n configurations (labs[k], params[k]) once, in
  * order, each after measure's own untimed warm-up: frame and evaluation
- * seconds in frame[r * n + k], eval[r * n + k]; lit[k] its lit candidates. */
+ * seconds in frame[r * n + k], eval[r * n + k]; last[k] its last Point
+ * (lit candidates, texel bytes per lit candidate). */
 static bool timed_rounds(Lab *const *labs, const Technique *t, double (*params)[TECH_MAX_PARAMS], int n, int rounds,
-                         double *frame, double *eval, long *lit, Error *err)
+                         double *frame, double *eval, Point *last, Error *err)
 {
     for (int r = 0; r < rounds; r++)
         for (int k = 0; k < n; k++) {
-            Point p;
-            if (!measure(labs[k], t, params[k], 1, &p, err)) return false;
-            frame[r * n + k] = p.frame_s;
-            eval[r * n + k] = p.eval_s;
-            lit[k] = p.lit;
+            Point *p = &last[k];
+            if (!measure(labs[k], t, params[k], 1, p, err)) return false;
+            frame[r * n + k] = p->frame_s;
+            eval[r * n + k] = p->eval_s;
         }
     return true;
 }
@@ -470,6 +474,7 @@ static bool assigned(const Options *o, const char *name)
  * per-round ratios large / small. */
 typedef struct RadiusPair {
     double frame_ms[2], eval_ms[2], frame_ratio, eval_ratio;
+    double bytes[2]; /* texel bytes read per lit candidate (machine-independent: early outs, subdivision) */
 } RadiusPair;
 
 static bool both_radii(const Options *o, Subject *sj, int map_size, RadiusPair *rp, char *end, size_t n, Error *err)
@@ -477,7 +482,7 @@ static bool both_radii(const Options *o, Subject *sj, int map_size, RadiusPair *
     static const double radii[2] = {LIGHT_SMALL, LIGHT_LARGE};
     int rounds = o->c.repeat > 64 ? 64 : o->c.repeat, ms = tech_param_index(sj->t, "map_size");
     double params[2][TECH_MAX_PARAMS], frame[2 * 64], eval[2 * 64];
-    long lit[2];
+    Point last[2];
     Lab *labs[2] = {NULL, NULL};
     bool ok = true;
     for (int k = 0; ok && k < 2; k++) {
@@ -488,12 +493,13 @@ static bool both_radii(const Options *o, Subject *sj, int map_size, RadiusPair *
         const char *ov[] = {"camera.width=320", "camera.height=240", r};
         ok = (labs[k] = open_lab(o, sj, ov, 3, err)) != NULL;
     }
-    ok = ok && timed_rounds(labs, sj->t, params, 2, rounds, frame, eval, lit, err);
+    ok = ok && timed_rounds(labs, sj->t, params, 2, rounds, frame, eval, last, err);
     if (ok) {
         where(sj, lab_scene(labs[1]), o->c.threads, end, n);
         for (int k = 0; k < 2; k++) {
             rp->frame_ms[k] = round_median(frame, rounds, 2, k) * 1e3;
             rp->eval_ms[k] = round_median(eval, rounds, 2, k) * 1e3;
+            rp->bytes[k] = last[k].bytes_per_lit;
         }
         rp->frame_ratio = round_ratio(frame, rounds, 2, 1, 1.0);
         rp->eval_ratio = round_ratio(eval, rounds, 2, 1, 1.0);
@@ -529,12 +535,14 @@ static bool light_size(const Options *o, Subject *sj, Error *err)
     announce(o, sj, "lightsize");
     double ratio = rp.frame_ratio;
     char row[4096];
-    snprintf(row, sizeof row, "%s,%d,%g,%g,%.4f,%.4f,%.3f,%.1f,%s,%.4f,%.4f,%.3f,%s,%s", t->name, map_size,
-             LIGHT_SMALL, LIGHT_LARGE, rp.frame_ms[0], rp.frame_ms[1], ratio, CONSTANT_BOUND,
-             ratio <= CONSTANT_BOUND ? "yes" : "no", rp.eval_ms[0], rp.eval_ms[1], rp.eval_ratio, note, end);
+    snprintf(row, sizeof row, "%s,%d,%g,%g,%.4f,%.4f,%.3f,%.1f,%s,%.4f,%.4f,%.3f,%.1f,%.1f,%.3f,%s,%s", t->name,
+             map_size, LIGHT_SMALL, LIGHT_LARGE, rp.frame_ms[0], rp.frame_ms[1], ratio, CONSTANT_BOUND,
+             ratio <= CONSTANT_BOUND ? "yes" : "no", rp.eval_ms[0], rp.eval_ms[1], rp.eval_ratio, rp.bytes[0],
+             rp.bytes[1], rp.bytes[1] / rp.bytes[0], note, end);
     printf("  %-18s map_size %d: radius %g: frame %.3f ms (eval %.3f), radius %g: frame %.3f ms (eval %.3f), "
-           "ratio %.2f (bound %.1f; eval %.2f)%s\n", t->name, map_size, LIGHT_SMALL, rp.frame_ms[0], rp.eval_ms[0],
-           LIGHT_LARGE, rp.frame_ms[1], rp.eval_ms[1], ratio, CONSTANT_BOUND, rp.eval_ratio,
+           "ratio %.2f (bound %.1f; eval %.2f; texel bytes per lit sample %.0f -> %.0f, x%.2f)%s\n", t->name,
+           map_size, LIGHT_SMALL, rp.frame_ms[0], rp.eval_ms[0], LIGHT_LARGE, rp.frame_ms[1], rp.eval_ms[1], ratio,
+           CONSTANT_BOUND, rp.eval_ratio, rp.bytes[0], rp.bytes[1], rp.bytes[1] / rp.bytes[0],
            ratio <= CONSTANT_BOUND ? "" : "  OVER");
     return append(o, "light_size.csv", LIGHT_SIZE_HEADER, row, err);
 }
@@ -554,6 +562,7 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
     int pi = sweep_on_scene(o) ? -1 : tech_param_index(sj->t, o->axis);
     Lab *labs[MAX_POINTS] = {0};
     double params[MAX_POINTS][TECH_MAX_PARAMS], frame[64 * MAX_POINTS], eval[64 * MAX_POINTS];
+    Point last[MAX_POINTS];
     long lit[MAX_POINTS] = {0};
     bool ok = true;
     for (int k = 0; ok && k < n; k++) {
@@ -569,7 +578,8 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
         ok = (labs[k] = open_lab(o, sj, ov, pi >= 0 ? 2 : 3, err)) != NULL;
     }
     if (ok) announce(o, sj, "sweep");
-    ok = ok && timed_rounds(labs, sj->t, params, n, rounds, frame, eval, lit, err);
+    ok = ok && timed_rounds(labs, sj->t, params, n, rounds, frame, eval, last, err);
+    for (int k = 0; ok && k < n; k++) lit[k] = last[k].lit;
     for (int k = 0; ok && k < n; k++) {
         double f = round_median(frame, rounds, n, k), e = round_median(eval, rounds, n, k);
         double per_sample = lit[k] > 0 ? e * 1e9 / (double)lit[k] : NAN; /* no lit candidate: NaN, shown */
