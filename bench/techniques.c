@@ -27,12 +27,20 @@
  *     hand count where one is known: a K x K box PCF reads K^2 texels per lit
  *     candidate, a single-layer sm one, hard and single_sample_rt trace one
  *     ray (bench_lab_open's scene: every sample lies in the fitted map).
+ *   sweep (only with --only): cost against one axis, --sweep NAME=V1,V2,...
+ *     (a parameter of the selected techniques, or a scene key): every round
+ *     times each value once; ns per lit candidate, and per lit candidate per
+ *     unit of the value, over the first value's (linear: near 1; issue 15);
+ *   matched (only with --only): the prefiltered PCSS family (or -t's) over
+ *     map sizes 64 ... 2048: penumbra RMSE against the Embree reference
+ *     (--samples) and frame time, and the time each needs at pcss's RMSE
+ *     (its defaults) over pcss's, timed in the same rounds (issue 16).
  * -p NAME=VALUE sets that parameter in every technique that has one (the
  * rows' `settings` column lists what was set).
  * Rows: DIR/growth.csv, DIR/constant_time.csv, DIR/threads_eval.csv, DIR/light_size.csv,
- * DIR/work.csv.
- * Usage: techniques [--only growth|constant|threads|lightsize|work] [-t TECH]... [-p NAME=VALUE]...
- *                   [--threads N] [--repeat R] [--quick] [-o DIR] [SCENE] */
+ * DIR/work.csv, DIR/sweep.csv, DIR/matched_curve.csv, DIR/matched.csv.
+ * Usage: techniques [--only growth|constant|threads|lightsize|work|sweep|matched] [-t TECH]... [-p NAME=VALUE]...
+ *                   [--sweep NAME=V1,V2,...] [--samples N] [--threads N] [--repeat R] [--quick] [-o DIR] [SCENE] */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
