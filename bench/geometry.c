@@ -9,8 +9,19 @@
  *     against `sm` at map_size 2048 and 4096 and against `hard`, frame time
  *     (the counts built every frame plus the evaluation; sm: its map), each
  *     pair alternating in every round (bench_paired), on the given scenes.
- * Rows: DIR/silhouette.csv, DIR/volumes.csv.
- * Usage: geometry [--silhouette] [--volumes] [--threads N] [--repeat R] [-o DIR] [SCENE...] */
+ *   --vsm: `view_sample_mapping` at 256 light samples (its default) against
+ *     the Embree reference at 256 samples on the same view (r2, seed 1,
+ *     computed, not cached: reference_compute), frame time (its mapping is
+ *     its prepare) against the reference's time, alternating per round, on
+ *     sphere-on-plane and the bunny (320 x 240; --quick 160 x 120); and its
+ *     frame time against the ball's triangles on sphere-on-plane
+ *     (segments 16 ... 128): ns per caster triangle per lit candidate, the
+ *     pairs the influence regions are a subset of (view_sample_mapping.c
+ *     counts no influence-region work: the ratio to the smallest size says
+ *     how far below that bound its culling keeps the cost).
+ * Rows: DIR/silhouette.csv, DIR/volumes.csv, DIR/vsm_reference.csv, DIR/vsm_triangles.csv.
+ * Usage: geometry [--silhouette] [--volumes] [--vsm] [--quick] [--threads N] [--repeat R] [-o DIR] [SCENE...] */
+#include <math.h>
 #include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,9 +34,12 @@
 #define SIL_HEADER "segments,triangles,silhouette_edges,build_ms,ns_per_triangle,ns_per_triangle_over_smallest," \
                    BENCH_TAIL_HEADER "\n"
 #define VOL_HEADER "scene,triangles,versus,map_size,shadow_volume_ms,other_ms,ratio," BENCH_TAIL_HEADER "\n"
+#define VSM_REF_HEADER "scene,triangles,width,height,samples,vsm_ms,reference_ms,ratio," BENCH_TAIL_HEADER "\n"
+#define VSM_TRI_HEADER "segments,triangles,lit_candidates,frame_ms,ns_per_triangle_sample," \
+                       "ns_per_triangle_sample_over_smallest," BENCH_TAIL_HEADER "\n"
 
 typedef struct Options {
-    bool silhouette, volumes;
+    bool silhouette, volumes, vsm, quick;
 } Options;
 
 static int own_option(void *options, const char *arg, const char *value)
@@ -34,6 +48,8 @@ static int own_option(void *options, const char *arg, const char *value)
     (void)value;
     if (strcmp(arg, "--silhouette") == 0) return o->silhouette = true, 1;
     if (strcmp(arg, "--volumes") == 0) return o->volumes = true, 1;
+    if (strcmp(arg, "--vsm") == 0) return o->vsm = true, 1;
+    if (strcmp(arg, "--quick") == 0) return o->quick = true, 1;
     return 0;
 }
 
@@ -163,17 +179,144 @@ static bool bench_volumes(const BenchCommon *c, Error *err)
     return true;
 }
 
+/* ---- view sample mapping against the reference ----------------------------- */
+
+typedef struct VsmRun {
+    Lab *lab;
+    const Technique *t;
+    double params[TECH_MAX_PARAMS];
+    int samples;
+} VsmRun;
+
+/* The Embree reference's own rays for light 1 at `samples` (what
+ * view_sample_mapping's light samples are, bit for bit), computed. */
+static bool reference_s(Lab *lab, int samples, double *s, Error *err)
+{
+    ResourceManager *rm = lab_resources(lab);
+    const Scene *sc = lab_scene(lab);
+    const RtScene *bvh = res_bvh(rm, sc, RT_CASTERS, err);
+    const ViewSamples *vs = bvh ? res_view_samples(rm, sc, err) : NULL;
+    const uint8_t *cls = vs ? res_classes(rm, sc, 0, err) : NULL;
+    ReferenceParams prm = {MEASURE_VISIBILITY, samples, SAMPLING_R2, 1, false};
+    Reference ref;
+    double t0 = timer_now_s();
+    bool ok = cls && reference_compute(bvh, sc, 0, vs, cls, &prm, &ref, err);
+    *s = timer_now_s() - t0;
+    if (ok) reference_free(&ref);
+    return ok;
+}
+
+static bool vsm_round(void *run, double *a_s, double *b_s, Error *err)
+{
+    VsmRun *v = run;
+    return frame_s(v->lab, v->t, v->params, a_s, err) && reference_s(v->lab, v->samples, b_s, err);
+}
+
+static const char *const *view_size(const Options *o)
+{
+    static const char *const full[] = {"camera.width=320", "camera.height=240"};
+    static const char *const quick[] = {"camera.width=160", "camera.height=120"};
+    return o->quick ? quick : full;
+}
+
+static bool vsm_versus_reference(const BenchCommon *c, const Options *o, const char *scene, const char *path,
+                                 Error *err)
+{
+    VsmRun v = {.samples = 256};
+    if (!(v.t = tech_find("view_sample_mapping", err))) return false;
+    tech_params_default(v.t, v.params);
+    char setting[64];
+    snprintf(setting, sizeof setting, "samples=%d", v.samples);
+    if (!tech_param_parse(v.t, setting, v.params, err) || !(v.lab = lab_open(scene, view_size(o), 2, err)))
+        return false;
+    double med[3];
+    bool ok = bench_paired(vsm_round, &v, c->repeat, med, err);
+    const Scene *sc = lab_scene(v.lab);
+    if (ok) {
+        char name[300], row[1024], tail[512];
+        bench_csv_field(name, sizeof name, scene);
+        bench_tail(tail, sizeof tail, c->threads);
+        snprintf(row, sizeof row, "%s,%ld,%d,%d,%d,%.3f,%.3f,%.3f,%s\n", name, scene_triangles(sc), sc->camera.width,
+                 sc->camera.height, v.samples, med[0] * 1e3, med[1] * 1e3, med[2], tail);
+        printf("vsm: %s %dx%d: view_sample_mapping %.3f ms, reference (%d samples) %.3f ms: ratio %.3f\n", scene,
+               sc->camera.width, sc->camera.height, med[0] * 1e3, v.samples, med[1] * 1e3, med[2]);
+        ok = bench_csv_append(path, VSM_REF_HEADER, row, err);
+    }
+    lab_close(v.lab);
+    return ok;
+}
+
+/* Frame time against the ball's triangles, per (caster triangle, lit candidate) pair. */
+static bool vsm_triangles(const BenchCommon *c, const Options *o, Error *err)
+{
+    static const int segments[] = {16, 32, 64, 128};
+    char path[4096];
+    snprintf(path, sizeof path, "%s/vsm_triangles.csv", c->dir);
+    if (!bench_csv_reset(path, VSM_TRI_HEADER, err)) return false;
+    const Technique *t = tech_find("view_sample_mapping", err);
+    if (!t) return false;
+    double params[TECH_MAX_PARAMS], smallest = 0.0;
+    tech_params_default(t, params);
+    for (size_t k = 0; k < sizeof segments / sizeof segments[0]; k++) {
+        char seg[64];
+        snprintf(seg, sizeof seg, "objects[2].segments=%d", segments[k]);
+        const char *ov[] = {seg, view_size(o)[0], view_size(o)[1]};
+        Lab *lab = lab_open("scenes/sphere-on-plane.lua", ov, 3, err);
+        if (!lab) return false;
+        RenderRequest req = {.tech = t, .params = params, .light_index = 0, .repeat = 1};
+        double times[64];
+        long lit = 0;
+        int rounds = c->repeat > 64 ? 64 : c->repeat;
+        bool ok = true;
+        for (int r = 0; ok && r < rounds; r++) {
+            RenderResult res;
+            ok = lab_render(lab, &req, &res, err);
+            if (!ok) break;
+            times[r] = res.frame_s;
+            lit = res.lit_candidates;
+            render_result_free(&res);
+        }
+        long tris = ok ? scene_triangles(lab_scene(lab)) : 0;
+        lab_close(lab);
+        if (!ok) return false;
+        double f = bench_median(times, rounds);
+        double pairs = (double)tris * (double)lit, ns = pairs > 0.0 ? f * 1e9 / pairs : NAN; /* NaN: nothing lit */
+        if (k == 0) smallest = ns;
+        char row[512], tail[512];
+        bench_tail(tail, sizeof tail, c->threads);
+        snprintf(row, sizeof row, "%d,%ld,%ld,%.3f,%.4f,%.3f,%s\n", segments[k], tris, lit, f * 1e3, ns, ns / smallest,
+                 tail);
+        printf("vsm: %4d segments, %7ld triangles, %6ld lit samples: frame %9.3f ms, %.4f ns per triangle x sample "
+               "(x%.3f the smallest)\n", segments[k], tris, lit, f * 1e3, ns, ns / smallest);
+        if (!bench_csv_append(path, VSM_TRI_HEADER, row, err)) return false;
+    }
+    return true;
+}
+
+static bool bench_vsm(const BenchCommon *c, const Options *o, Error *err)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/vsm_reference.csv", c->dir);
+    if (!bench_csv_reset(path, VSM_REF_HEADER, err)) return false;
+    static const char *const scenes[] = {"scenes/sphere-on-plane.lua", "scenes/bunny.lua"};
+    for (int i = 0; i < 2; i++)
+        if (!vsm_versus_reference(c, o, scenes[i], path, err)) return false;
+    return vsm_triangles(c, o, err);
+}
+
 int main(int argc, char **argv)
 {
     BenchCommon c;
     Options o = {0};
     if (!bench_parse(argc, argv, 5, &c, own_option, &o))
-        return bench_usage("geometry [--silhouette] [--volumes] [--threads N] [--repeat R] [-o DIR] [SCENE...]");
-    if (!o.silhouette && !o.volumes) o.silhouette = o.volumes = true;
+        return bench_usage("geometry [--silhouette] [--volumes] [--vsm] [--quick] [--threads N] [--repeat R] [-o DIR] "
+                           "[SCENE...]");
+    if (!o.silhouette && !o.volumes && !o.vsm) o.silhouette = o.volumes = o.vsm = true;
     omp_set_num_threads(c.threads);
     rt_set_threads(c.threads);
     Error err;
     if (o.silhouette && !bench_silhouette(&c, &err)) return bench_fail("geometry", &err);
     if (o.volumes && !bench_volumes(&c, &err)) return bench_fail("geometry", &err);
+    if (o.vsm && !bench_vsm(&c, &o, &err)) return bench_fail("geometry", &err);
     return 0;
 }

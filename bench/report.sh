@@ -269,6 +269,37 @@ plot "
         done
         [ $first = 1 ] || plot growth_main "$script"
     fi
+    if [ -f "$dir/sweep.csv" ]; then
+        script="set title 'Evaluation time per lit candidate per unit of the axis, over the first value''s'
+set xlabel 'axis value'; set ylabel 'ratio (linear: 1)'; set logscale x; set grid; set key outside right noenhanced
+plot 1 with lines dashtype 2 title 'linear'"
+        for ta in $(column "$dir/sweep.csv" technique axis | tr ' ' '@' | sort -u); do
+            t=${ta%%@*} a=${ta#*@} d="$dir/sweep_$(printf '%s' "$ta" | tr -c 'A-Za-z0-9_\n' '_').dat"
+            column "$dir/sweep.csv" technique axis value per_value_ratio |
+                awk -v t="$t" -v a="$a" '$1 == t && $2 == a && $3 ~ /^[-+.0-9eE]+$/ && $4 != "nan" { print $3, $4 }' > "$d"
+            [ -s "$d" ] || { rm -f "$d"; continue; } # an enum's choices, or a 0: no per-unit figure
+            script="$script, '$d' using 1:2 with linespoints title '$t, $a'"
+        done
+        plot sweep "$script"
+    fi
+    if [ -f "$dir/matched_curve.csv" ]; then
+        for s in $(column "$dir/matched_curve.csv" scene | sort -u); do
+            script="set title 'Penumbra RMSE against frame time, $s (map sizes 64 ... 2048)'
+set xlabel 'frame time (ms)'; set ylabel 'penumbra RMSE'; set logscale xy; set grid; set key outside right noenhanced
+plot "
+            first=1
+            for t in $(column "$dir/matched_curve.csv" technique | sort -u); do
+                d="$dir/matched_${s}_$t.dat"
+                column "$dir/matched_curve.csv" scene technique frame_ms penumbra_rmse |
+                    awk -v s="$s" -v t="$t" '$1 == s && $2 == t { print $3, $4 }' > "$d"
+                [ -s "$d" ] || { rm -f "$d"; continue; }
+                [ $first = 1 ] || script="$script, "
+                script="$script'$d' using 1:2 with linespoints title '$t'"
+                first=0
+            done
+            [ $first = 1 ] || plot "matched_$s" "$script"
+        done
+    fi
     if [ -f "$dir/threads_eval.csv" ]; then
         n=$(column "$dir/threads_eval.csv" threads | sort -n | tail -1)
         script="set title 'Speed-up over 1 thread, 1 to $n threads (ideal: the diagonal)'
@@ -425,6 +456,11 @@ trap 'rm -f "$cmp" "$gone" "$sum" "$md.tmp$$"' EXIT
     echo "Constant in the light's size (the prefiltered PCSS family and occlusion textures claim it; pcss grows):"
     echo
     table light_size.csv technique map_size radius_small radius_large frame_small_ms frame_large_ms ratio within scene threads load_1min
+    echo "The same rows' evaluation times (the two radii alternate in every round; a frame also carries its map's build,"
+    echo "timed once when built), the texel bytes read per lit candidate (core/counters.h: what the early outs and"
+    echo "subdivisions leave to read), and where a technique refused the asked map size (its own cap), why:"
+    echo
+    table light_size.csv technique map_size settings eval_small_ms eval_large_ms eval_ratio bytes_small bytes_large bytes_ratio note
     echo "Machine-independent work per technique (core/counters.h), beside the hand count where one is known:"
     echo
     table work.csv technique texel_fetches_per_sample rays_per_sample frame_triangles frame_fragments frame_bytes_built hand_rule agrees light
@@ -448,6 +484,28 @@ trap 'rm -f "$cmp" "$gone" "$sum" "$md.tmp$$"' EXIT
     echo
     table silhouette.csv segments triangles silhouette_edges build_ms ns_per_triangle ns_per_triangle_over_smallest threads load_1min
     table volumes.csv scene triangles versus map_size shadow_volume_ms other_ms ratio threads load_1min commit
+    echo "view_sample_mapping against the Embree reference at 256 light samples on the same view, and its frame time"
+    echo "per (caster triangle, lit candidate) pair against the ball's triangles:"
+    echo
+    table vsm_reference.csv scene triangles width height samples vsm_ms reference_ms ratio threads load_1min commit
+    table vsm_triangles.csv segments triangles lit_candidates frame_ms ns_per_triangle_sample ns_per_triangle_sample_over_smallest threads load_1min
+    echo "## 9. Cost against one axis (issue 15) and error against time at pcss's penumbra RMSE (issue 16)"
+    echo
+    echo "Per lit candidate per unit of the axis, over the first value's (linear: near 1); ratios are medians of per-round ratios:"
+    echo
+    echo "![cost per unit](sweep.svg)"
+    echo
+    table sweep.csv technique axis value settings frame_ms eval_ms eval_ns_per_sample eval_ns_per_sample_per_value frame_ratio eval_ratio frame_per_value_ratio per_value_ratio threads load_1min
+    echo "Each technique's penumbra RMSE against frame time over map sizes (plots: one per scene):"
+    echo
+    [ -f "$dir/matched_curve.csv" ] &&
+        for s in $(column "$dir/matched_curve.csv" scene | sort -u); do echo "![$s](matched_$s.svg)"; done
+    echo
+    table matched_curve.csv technique scene map_size penumbra_rmse penumbra_noise_rms penumbra_samples frame_ms eval_ms note threads load_1min
+    echo "The frame time each needs at pcss's penumbra RMSE (pcss at its defaults), over pcss's (reached: interpolated"
+    echo "in log-log on the curve, at_first_point: already below it at 64^2, an upper bound; no: not reached):"
+    echo
+    table matched.csv technique scene target_rmse pcss_frame_ms frame_at_target_ms ratio pcss_eval_ms eval_at_target_ms eval_ratio reached note threads load_1min
 } > "$md"
 # The summary goes above the first section, once every table has compared its figures.
 summary > "$sum"

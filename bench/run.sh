@@ -71,6 +71,10 @@ run "$bin/techniques" --only constant -t esm -p classifier=none -p exponent=20 -
     --repeat "$repeat" -o "$out"
 # constant in the light's size (course §5.2.2, §5.2.5): every soft technique on the bunny, radius 0.05 and 0.8
 run "$bin/techniques" --only lightsize $q --threads "$threads" --repeat "$repeat" -o "$out" scenes/bunny.lua
+# pcss at its defaults reads 16 + 16 Poisson taps whatever the light: constant by construction; reading every
+# texel of its windows (up to its max_radius = 32 texels) it grows
+run "$bin/techniques" --only lightsize -t pcss -p sampling=exhaustive $q --threads "$threads" --repeat "$repeat" \
+    -o "$out" scenes/bunny.lua
 # machine-independent work counters beside the hand counts (160x120; exits 1 on a disagreement)
 run "$bin/techniques" --only work --threads "$threads" -o "$out"
 
@@ -91,8 +95,26 @@ run "$bin/memory" --res 4096 --threads "$threads" -o "$out"
 step 7 "start-up"
 run "$bin/startup" "$bin/../shadowlab" --repeat 21 -o "$out"
 
-step 8 "geometry: silhouette extraction against triangles, shadow volumes against sm and hard"
-run "$bin/geometry" --threads "$threads" --repeat "$repeat" -o "$out" scenes/bunny.lua scenes/terrain.lua
+step 8 "geometry: silhouette extraction against triangles, shadow volumes against sm and hard, view sample mapping against the reference"
+run "$bin/geometry" $q --threads "$threads" --repeat "$repeat" -o "$out" scenes/bunny.lua scenes/terrain.lua
+
+step 9 "issue 15: cost against slices, texel budget and light size; issue 16: error against time at pcss's RMSE"
+# occlusion textures linear in slices; backprojection linear in its texel budget T, and against the light's
+# radius with a budget that never binds (256 lexels); the bitmask accumulation against the area one
+if [ "$quick" = 1 ]; then sweep_map="-p map_size=512"; else sweep_map=; fi
+# (512^2: at 1024^2 its N-buffer slice tables pass the 2 GiB cap from 8 slices on, 2.09 GiB)
+run "$bin/techniques" --only sweep -t occlusion_textures --sweep slices=4,6,8,12,16 -p map_size=512 \
+    --threads "$threads" --repeat "$repeat" -o "$out"
+run "$bin/techniques" --only sweep -t backprojection --sweep budget=2,4,8,16,32,64 $sweep_map --threads "$threads" \
+    --repeat "$repeat" -o "$out"
+run "$bin/techniques" --only sweep -t backprojection -p budget=256 --sweep 'lights[1].radius=0.05,0.1,0.2,0.4,0.8' \
+    $sweep_map --threads "$threads" --repeat "$repeat" -o "$out"
+run "$bin/techniques" --only sweep -t backprojection --sweep accumulate=bitmask,area $sweep_map --threads "$threads" \
+    --repeat "$repeat" -o "$out"
+# the prefiltered PCSS family against pcss at pcss's penumbra RMSE (map sizes 64 ... 2048; QUICK: ... 1024, 160x120)
+for s in scenes/bunny.lua scenes/sphere-on-plane.lua scenes/overlap.lua; do
+    run "$bin/techniques" --only matched $q --samples "$samples" --threads "$threads" --repeat "$repeat" -o "$out" "$s"
+done
 
 uptime >> "$out/load.txt"
 current=report

@@ -16,8 +16,10 @@
  *     curve 1, 2, 4, ... N threads (bench.h's BenchCurve), with the CPU time
  *     a technique's threads ran (lab.h's eval_cpu_s, eval_busiest_s);
  *   lightsize: every soft technique that handles sphere lights at light 1's
- *     radius 0.05 and 0.8 (map_size 2048 where it has one; --quick: 1024):
- *     frame time at 0.8 over 0.05, against the 1.2 bound the constant-time
+ *     radius 0.05 and 0.8 (map_size 2048 where it has one; --quick: 1024;
+ *     -p map_size=N: N; where it refuses that size, the largest half it accepts),
+ *     the two radii in two Labs timed alternately in every round: frame (and
+ *     evaluation) time at 0.8 over 0.05, against the 1.2 bound the constant-time
  *     claims name (prefiltered PCSS, CSSM, VSSM, ESSM, moment soft shadows:
  *     course §5.2.2; occlusion textures: §5.2.5), `pcss` beside them growing;
  *   work: each technique's machine-independent work counters (core/counters.h:
@@ -26,12 +28,20 @@
  *     hand count where one is known: a K x K box PCF reads K^2 texels per lit
  *     candidate, a single-layer sm one, hard and single_sample_rt trace one
  *     ray (bench_lab_open's scene: every sample lies in the fitted map).
+ *   sweep (only with --only): cost against one axis, --sweep NAME=V1,V2,...
+ *     (a parameter of the selected techniques, or a scene key): every round
+ *     times each value once; ns per lit candidate, and per lit candidate per
+ *     unit of the value, over the first value's (linear: near 1; issue 15);
+ *   matched (only with --only): the prefiltered PCSS family (or -t's) over
+ *     map sizes 64 ... 2048: penumbra RMSE against the Embree reference
+ *     (--samples) and frame time, and the time each needs at pcss's RMSE
+ *     (its defaults) over pcss's, timed in the same rounds (issue 16).
  * -p NAME=VALUE sets that parameter in every technique that has one (the
  * rows' `settings` column lists what was set).
  * Rows: DIR/growth.csv, DIR/constant_time.csv, DIR/threads_eval.csv, DIR/light_size.csv,
- * DIR/work.csv.
- * Usage: techniques [--only growth|constant|threads|lightsize|work] [-t TECH]... [-p NAME=VALUE]...
- *                   [--threads N] [--repeat R] [--quick] [-o DIR] [SCENE] */
+ * DIR/work.csv, DIR/sweep.csv, DIR/matched_curve.csv, DIR/matched.csv.
+ * Usage: techniques [--only growth|constant|threads|lightsize|work|sweep|matched] [-t TECH]... [-p NAME=VALUE]...
+ *                   [--sweep NAME=V1,V2,...] [--samples N] [--threads N] [--repeat R] [--quick] [-o DIR] [SCENE] */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -39,6 +49,8 @@
 #include <string.h>
 #include "bench.h"
 #include "core/timer.h"
+#include "lab/compare.h"
+#include "resources/refcache.h"
 #include "techniques/smap.h"
 
 #define MAX_ITEMS 32
@@ -50,7 +62,17 @@
 #define CONSTANT_HEADER "technique,prefilter,K_min,K_max,frame_min_ms,frame_max_ms,ratio,bound,within," WHERE_HEADER
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup,cpu_ms_1,cpu_ms_n,busiest_ms_n,cpu_bound," WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
+                          "eval_small_ms,eval_large_ms,eval_ratio,bytes_small,bytes_large,bytes_ratio,note," \
                           WHERE_HEADER
+#define LIGHT_SMALL 0.05 /* light 1's radii of the lightsize part, world units */
+#define LIGHT_LARGE 0.8
+#define SWEEP_HEADER "technique,axis,value,frame_ms,eval_ms,lit_candidates,eval_ns_per_sample," \
+                     "eval_ns_per_sample_per_value,frame_ratio,eval_ratio,frame_per_value_ratio,per_value_ratio," \
+                     WHERE_HEADER
+#define CURVE_HEADER "technique,map_size,penumbra_rmse,penumbra_noise_rms,penumbra_samples,frame_ms,eval_ms,note," \
+                     WHERE_HEADER
+#define MATCHED_HEADER "technique,target_rmse,pcss_frame_ms,frame_at_target_ms,ratio,pcss_eval_ms,eval_at_target_ms," \
+                       "eval_ratio,reached,note," WHERE_HEADER
 #define WORK_HEADER "technique,lit_candidates,texel_fetches_per_sample,texel_bytes_per_sample,rays_per_sample," \
                     "frame_triangles,frame_fragments,frame_texel_fetches,frame_rays,frame_bytes_built,hand_rule," \
                     "hand_texel_fetches_per_sample,hand_rays_per_sample,agrees," WHERE_HEADER
@@ -61,6 +83,12 @@ typedef struct Options {
     const char *techs[MAX_ITEMS], *settings[MAX_ITEMS];
     int num_techs, num_settings;
     bool quick;
+    const char *sweep; /* --sweep NAME=V1,V2,...: the sweep part's axis */
+    char axis[128];    /* its NAME: a technique parameter, or a scene key (holds '.' or '[') */
+    char value_text[MAX_POINTS][64]; /* its values as given: numbers, or an enum's choices */
+    double values[MAX_POINTS];        /* as numbers (NaN for a choice: no per-unit figures) */
+    int num_values;
+    int samples;       /* --samples N: the matched part's reference light samples */
 } Options;
 
 /* One technique as measured: its parameters (defaults, then -p) and light. */
@@ -77,6 +105,8 @@ typedef struct Point {
     double frame_s, eval_s, build_s;
     int built;
     double cpu_s, busiest_s; /* the evaluation's CPU seconds: all threads, the busiest (lab.h) */
+    long lit; /* lit candidates evaluated (what per-sample costs divide by) */
+    double bytes_per_lit; /* texel bytes one evaluation read per lit candidate (core/counters.h) */
 } Point;
 
 static int own_option(void *options, const char *a, const char *v)
@@ -85,6 +115,8 @@ static int own_option(void *options, const char *a, const char *v)
     if (strcmp(a, "--quick") == 0) return o->quick = true;
     if (!v) return 0;
     if (strcmp(a, "--only") == 0) o->only = v;
+    else if (strcmp(a, "--sweep") == 0 && strchr(v, '=')) o->sweep = v;
+    else if (strcmp(a, "--samples") == 0) return bench_parse_int(v, 1, REFERENCE_MAX_SAMPLES, &o->samples) ? 2 : 0;
     else if (strcmp(a, "-t") == 0 && o->num_techs < MAX_ITEMS) o->techs[o->num_techs++] = v;
     else if (strcmp(a, "-p") == 0 && o->num_settings < MAX_ITEMS && strchr(v, '=')) o->settings[o->num_settings++] = v;
     else return 0;
@@ -109,23 +141,66 @@ static ParamName param_name(const char *assignment)
     return n;
 }
 
-/* Whether a technique -t selects has the parameter -p assigns (a typo is refused). */
-static bool setting_used(const Options *o, const char *assignment)
+/* Whether the --sweep axis is a scene key (lights[1].radius), not a parameter. */
+static bool sweep_on_scene(const Options *o) { return strchr(o->axis, '.') || strchr(o->axis, '['); }
+
+/* Whether a technique -t selects has the parameter `option` (-p, --sweep) assigns (a typo is refused). */
+static bool setting_used(const Options *o, const char *option, const char *assignment)
 {
     ParamName name = param_name(assignment);
     for (int i = 0; i < tech_count(); i++)
         if (wanted(o, tech_at(i)->name) && tech_param_index(tech_at(i), name.s) >= 0) return true;
-    fprintf(stderr, "techniques: -p %s: no selected technique has a parameter '%s'\n", assignment, name.s);
+    fprintf(stderr, "techniques: %s %s: no selected technique has a parameter '%s'\n", option, assignment, name.s);
     return false;
+}
+
+/* --sweep NAME=V1,V2,...: at most MAX_POINTS values, of a scene key or of a
+ * parameter of a selected technique (each value checked by every selected
+ * technique that has it: its range or choices named where one is refused). */
+static bool parse_sweep(Options *o)
+{
+    snprintf(o->axis, sizeof o->axis, "%s", param_name(o->sweep).s);
+    for (const char *v = strchr(o->sweep, '=') + 1; *v;) {
+        size_t len = strcspn(v, ",");
+        if (len == 0 || len >= sizeof o->value_text[0] || o->num_values == MAX_POINTS) {
+            fprintf(stderr, "techniques: --sweep %s: expected NAME=V1,V2,... with at most %d non-empty values\n",
+                    o->sweep, MAX_POINTS);
+            return false;
+        }
+        char *text = o->value_text[o->num_values], *end;
+        snprintf(text, sizeof o->value_text[0], "%.*s", (int)len, v);
+        double x = strtod(text, &end);
+        o->values[o->num_values++] = *end == '\0' && isfinite(x) ? x : NAN;
+        v += len + (v[len] == ',');
+    }
+    if (o->num_values == 0 || sweep_on_scene(o)) return o->num_values > 0;
+    if (!setting_used(o, "--sweep", o->sweep)) return false;
+    for (int i = 0; i < tech_count(); i++) {
+        const Technique *t = tech_at(i);
+        if (!wanted(o, t->name) || tech_param_index(t, o->axis) < 0) continue;
+        for (int k = 0; k < o->num_values; k++) {
+            double scratch[TECH_MAX_PARAMS];
+            char a[256];
+            Error err;
+            tech_params_default(t, scratch);
+            snprintf(a, sizeof a, "%s=%s", o->axis, o->value_text[k]);
+            if (!tech_param_parse(t, a, scratch, &err)) {
+                fprintf(stderr, "techniques: --sweep: %s: %s\n", t->name, err.msg);
+                return false;
+            }
+        }
+    }
+    return true;
 }
 
 static bool parse_options(int argc, char **argv, Options *o)
 {
-    *o = (Options){.quick = false};
+    *o = (Options){.quick = false, .samples = 64};
     if (!bench_parse(argc, argv, 3, &o->c, own_option, o) || o->c.num_scenes > 1) return false;
-    if (o->only && strcmp(o->only, "growth") != 0 && strcmp(o->only, "constant") != 0 &&
-        strcmp(o->only, "threads") != 0 && strcmp(o->only, "lightsize") != 0 && strcmp(o->only, "work") != 0)
-        return false;
+    static const char *const parts[] = {"growth", "constant", "threads", "lightsize", "work", "sweep", "matched"};
+    bool known = !o->only;
+    for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++) known = known || strcmp(o->only, parts[i]) == 0;
+    if (!known || (o->only && strcmp(o->only, "sweep") == 0 && !o->sweep)) return false;
     for (int i = 0; i < o->num_techs; i++) {
         Error err;
         if (strcmp(o->techs[i], "reference") == 0 || tech_find(o->techs[i], &err)) continue;
@@ -133,7 +208,8 @@ static bool parse_options(int argc, char **argv, Options *o)
         return false;
     }
     for (int i = 0; i < o->num_settings; i++)
-        if (!setting_used(o, o->settings[i])) return false;
+        if (!setting_used(o, "-p", o->settings[i])) return false;
+    if (o->sweep && !parse_sweep(o)) return false;
     o->scene = o->c.num_scenes ? o->c.scenes[0] : "scenes/sphere-on-plane.lua";
     return true;
 }
@@ -195,7 +271,9 @@ static bool measure(Lab *lab, const Technique *t, const double *params, int repe
     RenderTiming timing = {.warmup = 1, .budget_s = 0.0};
     RenderResult r;
     if (!lab_render_timed(lab, &req, &timing, &r, err)) return false;
-    *p = (Point){r.frame_s, r.eval_median_s, r.tech_build_s, 0, r.eval_cpu_s, r.eval_busiest_s};
+    double lit = r.lit_candidates > 0 ? (double)r.lit_candidates : NAN; /* none lit: NaN, shown */
+    *p = (Point){r.frame_s, r.eval_median_s, r.tech_build_s, 0, r.eval_cpu_s, r.eval_busiest_s, r.lit_candidates,
+                 (double)r.eval_work.texel_bytes / lit};
     for (int i = 0; i < r.num_tech_resources; i++) p->built += r.tech_resources[i].built;
     render_result_free(&r);
     return true;
@@ -351,6 +429,40 @@ static bool constant_time(const Options *o, Subject *sj, Error *err)
     return append(o, "constant_time.csv", CONSTANT_HEADER, row, err);
 }
 
+/* Median over rounds of point k's per-round time over point 0's, times
+ * scale (t[r * n + k]: round r, point k). */
+static double round_ratio(const double *t, int rounds, int n, int k, double scale)
+{
+    double v[64];
+    for (int r = 0; r < rounds; r++) v[r] = t[r * n + k] / t[r * n] * scale;
+    return bench_median(v, rounds);
+}
+
+/* Median over rounds of point k's time. */
+static double round_median(const double *t, int rounds, int n, int k)
+{
+    double v[64];
+    for (int r = 0; r < rounds; r++) v[r] = t[r * n + k];
+    return bench_median(v, rounds);
+}
+
+/* Every round times each of n configurations (labs[k], params[k]) once, in
+ * order, each after measure's own untimed warm-up: frame and evaluation
+ * seconds in frame[r * n + k], eval[r * n + k]; last[k] its last Point
+ * (lit candidates, texel bytes per lit candidate). */
+static bool timed_rounds(Lab *const *labs, const Technique *t, double (*params)[TECH_MAX_PARAMS], int n, int rounds,
+                         double *frame, double *eval, Point *last, Error *err)
+{
+    for (int r = 0; r < rounds; r++)
+        for (int k = 0; k < n; k++) {
+            Point *p = &last[k];
+            if (!measure(labs[k], t, params[k], 1, p, err)) return false;
+            frame[r * n + k] = p->frame_s;
+            eval[r * n + k] = p->eval_s;
+        }
+    return true;
+}
+
 /* ---- constant in the light's size -------------------------------------------- */
 
 static bool soft_on_spheres(const Technique *t)
@@ -358,42 +470,312 @@ static bool soft_on_spheres(const Technique *t)
     return strcmp(t->family, "soft") == 0 && (t->lights & LIGHT_BIT(LIGHT_SPHERE));
 }
 
-/* Frame time at one radius of light 1 (a sphere on the bench's scenes). */
-static bool at_radius(const Options *o, Subject *sj, const double *params, double radius, Point *p, char *end,
-                      size_t n, Error *err)
+/* Whether -p assigned the parameter `name` (a part then leaves it as given). */
+static bool assigned(const Options *o, const char *name)
 {
-    char r[64];
-    snprintf(r, sizeof r, "lights[1].radius=%g", radius);
-    const char *ov[] = {"camera.width=320", "camera.height=240", r};
-    Lab *lab = open_lab(o, sj, ov, 3, err);
-    if (!lab) return false;
-    bool ok = measure(lab, sj->t, params, o->c.repeat, p, err);
-    if (ok && end) where(sj, lab_scene(lab), o->c.threads, end, n);
-    lab_close(lab);
+    for (int i = 0; i < o->num_settings; i++)
+        if (strcmp(param_name(o->settings[i]).s, name) == 0) return true;
+    return false;
+}
+
+/* The two radii's times at map_size `map_size` (0: the technique has none),
+ * one Lab each, alternating in every round (timed_rounds): medians in
+ * frame_ms[2], eval_ms[2]; *frame_ratio, *eval_ratio the medians of the
+ * per-round ratios large / small. */
+typedef struct RadiusPair {
+    double frame_ms[2], eval_ms[2], frame_ratio, eval_ratio;
+    double bytes[2]; /* texel bytes read per lit candidate (machine-independent: early outs, subdivision) */
+} RadiusPair;
+
+static bool both_radii(const Options *o, Subject *sj, int map_size, RadiusPair *rp, char *end, size_t n, Error *err)
+{
+    static const double radii[2] = {LIGHT_SMALL, LIGHT_LARGE};
+    int rounds = o->c.repeat > 64 ? 64 : o->c.repeat, ms = tech_param_index(sj->t, "map_size");
+    double params[2][TECH_MAX_PARAMS], frame[2 * 64], eval[2 * 64];
+    Point last[2];
+    Lab *labs[2] = {NULL, NULL};
+    bool ok = true;
+    for (int k = 0; ok && k < 2; k++) {
+        memcpy(params[k], sj->params, sizeof params[k]);
+        if (ms >= 0) params[k][ms] = map_size;
+        char r[64];
+        snprintf(r, sizeof r, "lights[1].radius=%g", radii[k]);
+        const char *ov[] = {"camera.width=320", "camera.height=240", r};
+        ok = (labs[k] = open_lab(o, sj, ov, 3, err)) != NULL;
+    }
+    ok = ok && timed_rounds(labs, sj->t, params, 2, rounds, frame, eval, last, err);
+    if (ok) {
+        where(sj, lab_scene(labs[1]), o->c.threads, end, n);
+        for (int k = 0; k < 2; k++) {
+            rp->frame_ms[k] = round_median(frame, rounds, 2, k) * 1e3;
+            rp->eval_ms[k] = round_median(eval, rounds, 2, k) * 1e3;
+            rp->bytes[k] = last[k].bytes_per_lit;
+        }
+        rp->frame_ratio = round_ratio(frame, rounds, 2, 1, 1.0);
+        rp->eval_ratio = round_ratio(eval, rounds, 2, 1, 1.0);
+    }
+    lab_close(labs[0]);
+    lab_close(labs[1]);
     return ok;
 }
 
+/* At map_size 2048 (--quick: 1024; -p map_size=N: N), or, where the technique
+ * refuses that with its own error (a resource over its cap), at the first of
+ * half, a quarter, ... (down to 256) it accepts, as memory.c does; the row's
+ * note names the size refused and why. Only a technique that refuses every
+ * size (or has no map_size and refuses) fails. */
 static bool light_size(const Options *o, Subject *sj, Error *err)
 {
-    static const double small = 0.05, large = 0.8;
     const Technique *t = sj->t;
-    double params[TECH_MAX_PARAMS];
-    memcpy(params, sj->params, sizeof params);
-    int ms = tech_param_index(t, "map_size"), map_size = o->quick ? 1024 : 2048;
-    if (ms >= 0) params[ms] = map_size;
+    int ms = tech_param_index(t, "map_size");
+    int map_size = ms < 0 ? 0 : assigned(o, "map_size") ? (int)sj->params[ms] : o->quick ? 1024 : 2048;
+    RadiusPair rp;
+    char end[1024], note[1200] = "";
+    while (!both_radii(o, sj, map_size, &rp, end, sizeof end, err)) {
+        if (ms < 0 || map_size / 2 < 256) return false;
+        if (!note[0]) {
+            char why[1100];
+            snprintf(why, sizeof why, "map_size %d REFUSED (%s); measured at the largest half accepted", map_size,
+                     err->msg);
+            bench_csv_field(note, sizeof note, why);
+        }
+        printf("  %-18s map_size %d REFUSED (%s); trying %d\n", t->name, map_size, err->msg, map_size / 2);
+        map_size /= 2;
+    }
     announce(o, sj, "lightsize");
-    Point lo, hi;
-    char end[1024];
-    if (!at_radius(o, sj, params, small, &lo, NULL, 0, err) ||
-        !at_radius(o, sj, params, large, &hi, end, sizeof end, err))
-        return false;
-    double ratio = hi.frame_s / lo.frame_s;
-    char row[2048];
-    snprintf(row, sizeof row, "%s,%d,%g,%g,%.4f,%.4f,%.3f,%.1f,%s,%s", t->name, ms >= 0 ? map_size : 0, small, large,
-             lo.frame_s * 1e3, hi.frame_s * 1e3, ratio, CONSTANT_BOUND, ratio <= CONSTANT_BOUND ? "yes" : "no", end);
-    printf("  %-18s radius %g: %.3f ms, radius %g: %.3f ms, ratio %.2f (bound %.1f)%s\n", t->name, small,
-           lo.frame_s * 1e3, large, hi.frame_s * 1e3, ratio, CONSTANT_BOUND, ratio <= CONSTANT_BOUND ? "" : "  OVER");
+    double ratio = rp.frame_ratio;
+    char row[4096];
+    snprintf(row, sizeof row, "%s,%d,%g,%g,%.4f,%.4f,%.3f,%.1f,%s,%.4f,%.4f,%.3f,%.1f,%.1f,%.3f,%s,%s", t->name,
+             map_size, LIGHT_SMALL, LIGHT_LARGE, rp.frame_ms[0], rp.frame_ms[1], ratio, CONSTANT_BOUND,
+             ratio <= CONSTANT_BOUND ? "yes" : "no", rp.eval_ms[0], rp.eval_ms[1], rp.eval_ratio, rp.bytes[0],
+             rp.bytes[1], rp.bytes[1] / rp.bytes[0], note, end);
+    printf("  %-18s map_size %d: radius %g: frame %.3f ms (eval %.3f), radius %g: frame %.3f ms (eval %.3f), "
+           "ratio %.2f (bound %.1f; eval %.2f; texel bytes per lit sample %.0f -> %.0f, x%.2f)%s\n", t->name,
+           map_size, LIGHT_SMALL, rp.frame_ms[0], rp.eval_ms[0], LIGHT_LARGE, rp.frame_ms[1], rp.eval_ms[1], ratio,
+           CONSTANT_BOUND, rp.eval_ratio, rp.bytes[0], rp.bytes[1], rp.bytes[1] / rp.bytes[0],
+           ratio <= CONSTANT_BOUND ? "" : "  OVER");
     return append(o, "light_size.csv", LIGHT_SIZE_HEADER, row, err);
+}
+
+/* ---- cost against one axis (--sweep) ---------------------------------------- */
+
+/* The subject at every value of the --sweep axis (320 x 240): a parameter in
+ * one Lab, a scene key in one Lab per value. Every round times each value
+ * once, in order (measure's own warm-up before each); rows give the medians,
+ * the evaluation's ns per lit candidate and per lit candidate per unit of
+ * the value, and the medians of the per-round ratios to the first value:
+ * of the frame and evaluation times, and of both per lit candidate per unit
+ * of the value (linear in it: near 1). */
+static bool sweep_cost(const Options *o, Subject *sj, Error *err)
+{
+    int n = o->num_values, rounds = o->c.repeat > 64 ? 64 : o->c.repeat;
+    int pi = sweep_on_scene(o) ? -1 : tech_param_index(sj->t, o->axis);
+    Lab *labs[MAX_POINTS] = {0};
+    double params[MAX_POINTS][TECH_MAX_PARAMS], frame[64 * MAX_POINTS], eval[64 * MAX_POINTS];
+    Point last[MAX_POINTS];
+    long lit[MAX_POINTS] = {0};
+    bool ok = true;
+    for (int k = 0; ok && k < n; k++) {
+        char key[256];
+        snprintf(key, sizeof key, "%s=%s", o->axis, o->value_text[k]);
+        memcpy(params[k], sj->params, sizeof params[k]);
+        if (pi >= 0 && !(ok = tech_param_parse(sj->t, key, params[k], err))) break; /* parse_sweep checked it */
+        if (k > 0 && pi >= 0) {
+            labs[k] = labs[0];
+            continue;
+        }
+        const char *ov[] = {"camera.width=320", "camera.height=240", key};
+        ok = (labs[k] = open_lab(o, sj, ov, pi >= 0 ? 2 : 3, err)) != NULL;
+    }
+    if (ok) announce(o, sj, "sweep");
+    ok = ok && timed_rounds(labs, sj->t, params, n, rounds, frame, eval, last, err);
+    for (int k = 0; ok && k < n; k++) lit[k] = last[k].lit;
+    for (int k = 0; ok && k < n; k++) {
+        double f = round_median(frame, rounds, n, k), e = round_median(eval, rounds, n, k);
+        double per_sample = lit[k] > 0 ? e * 1e9 / (double)lit[k] : NAN; /* no lit candidate: NaN, shown */
+        double per_value = o->values[k] != 0.0 ? per_sample / o->values[k] : NAN; /* a choice (NaN) or 0: no unit */
+        double fr = round_ratio(frame, rounds, n, k, 1.0), er = round_ratio(eval, rounds, n, k, 1.0);
+        /* per lit candidate per unit, over the first value's: the lit counts
+         * differ with a scene key (a light's size moves the shadow) */
+        double scale = lit[0] > 0 && lit[k] > 0 && o->values[0] != 0.0 && o->values[k] != 0.0
+                           ? (double)lit[0] / (double)lit[k] * o->values[0] / o->values[k] : NAN; /* a 0: no unit */
+        double pvr = round_ratio(eval, rounds, n, k, scale), fpvr = round_ratio(frame, rounds, n, k, scale);
+        char row[4096], end[1024];
+        where(sj, lab_scene(labs[k]), o->c.threads, end, sizeof end);
+        snprintf(row, sizeof row, "%s,%s,%s,%.4f,%.4f,%ld,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%s", sj->t->name, o->axis,
+                 o->value_text[k], f * 1e3, e * 1e3, lit[k], per_sample, per_value, fr, er, fpvr, pvr, end);
+        printf("  %-18s %s %-8s frame %9.3f ms, eval %9.3f ms, %9.2f ns per lit sample, %8.3f per unit; "
+               "ratios to the first: frame %.3f, eval %.3f, per sample per unit: frame %.3f, eval %.3f\n",
+               sj->t->name, o->axis, o->value_text[k], f * 1e3, e * 1e3, per_sample, per_value, fr, er, fpvr, pvr);
+        ok = append(o, "sweep.csv", SWEEP_HEADER, row, err);
+    }
+    for (int k = 0; k < n; k++)
+        if (k == 0 || pi < 0) lab_close(labs[k]);
+    return ok;
+}
+
+/* ---- error against time at pcss's penumbra RMSE (issue 16) -------------------- */
+
+/* The prefiltered PCSS family of course §5.2.2 that issue 16 sets against pcss. */
+#define MATCHED_SMALLEST_MAP 64 /* texels per side */
+static const char *const matched_family[] = {"pcss", "pcss_prefiltered", "cssm", "vssm", "essm",
+                                             "evssm", "moment_soft", "dpcf"};
+
+static bool in_matched_family(const char *name)
+{
+    for (size_t i = 0; i < sizeof matched_family / sizeof matched_family[0]; i++)
+        if (strcmp(matched_family[i], name) == 0) return true;
+    return false;
+}
+
+/* One configuration of a curve: its penumbra error (once: it does not vary)
+ * and, per round, its frame time. */
+typedef struct CurvePoint {
+    int map_size;
+    double params[TECH_MAX_PARAMS];
+    double rmse, noise_rms;
+    long samples;
+    double frame[64], eval[64];
+} CurvePoint;
+
+/* The penumbra RMSE of one configuration against the Embree reference
+ * (o->samples light samples, r2, seed 1; the disk cache). */
+static bool penumbra_error(const Options *o, Lab *lab, const Technique *t, CurvePoint *cp, Error *err)
+{
+    char cache[1024];
+    refcache_default_dir(cache, sizeof cache);
+    CompareRequest req = {.tech = t, .params = cp->params, .light_index = 0, .repeat = 1, .warmup = 0,
+                          .reference = true, .ref = {MEASURE_VISIBILITY, o->samples, SAMPLING_R2, 1},
+                          .cache_dir = cache};
+    CompareResult res;
+    if (!lab_compare(lab, &req, &res, err)) return false;
+    const ErrorStats *pen = &res.metrics.region[REGION_PENUMBRA];
+    cp->rmse = pen->rmse;
+    cp->noise_rms = pen->noise_rms;
+    cp->samples = pen->count;
+    compare_result_free(&res);
+    return true;
+}
+
+/* The frame (eval: evaluation) time at RMSE `target` on a curve in order of
+ * map size, in one round: log-log interpolation on the first segment that brackets it; the
+ * first point's time where that point is already at or below it (an upper
+ * bound); NaN where no point reaches it. *how says which. */
+static double time_at_rmse(const CurvePoint *c, int n, int round, bool eval, double target, const char **how)
+{
+    *how = "no";
+    if (n > 0 && c[0].rmse <= target) {
+        *how = "at_first_point";
+        return eval ? c[0].eval[round] : c[0].frame[round];
+    }
+    for (int k = 0; k + 1 < n; k++) {
+        double ra = c[k].rmse, rb = c[k + 1].rmse;
+        if (!(ra > target && rb <= target)) continue; /* NaN rmse: not a bracket */
+        *how = "interpolated";
+        double ta = eval ? c[k].eval[round] : c[k].frame[round];
+        double tb = eval ? c[k + 1].eval[round] : c[k + 1].frame[round];
+        double u = ra == rb ? 0.0 : (log(target) - log(ra)) / (log(rb) - log(ra)); /* ra > target >= rb > 0 */
+        return exp(log(ta) + u * (log(tb) - log(ta)));
+    }
+    return NAN;
+}
+
+/* time_at_rmse's answer, as printed before the times. */
+static const char *reach_text(const char *how)
+{
+    if (strcmp(how, "no") == 0) return "NOT REACHED by any map size, ";
+    return strcmp(how, "at_first_point") == 0 ? "below it already at its smallest map (an upper bound), " : "";
+}
+
+/* The subject's curve over map sizes 64 ... 2048 (--quick: ... 1024) and
+ * pcss at its defaults (the target: its penumbra RMSE and frame time), in
+ * one Lab at 240 x 180 (--quick: 160 x 120), timed alternately in every
+ * round; the time the subject needs at pcss's RMSE over pcss's time is the
+ * median of the per-round ratios. A map size the subject refuses is noted
+ * and left out of the curve. */
+static bool matched(const Options *o, Subject *sj, Error *err)
+{
+    static const int maps[] = {MATCHED_SMALLEST_MAP, 128, 256, 512, 1024, 2048};
+    int nmaps = o->quick ? 5 : 6, rounds = o->c.repeat > 64 ? 64 : o->c.repeat;
+    const char *ov[] = {o->quick ? "camera.width=160" : "camera.width=240",
+                        o->quick ? "camera.height=120" : "camera.height=180"};
+    Subject base;
+    const Technique *pcss = tech_find("pcss", err);
+    if (!pcss || !subject_init(o, pcss, &base, err)) return false;
+    Lab *lab = open_lab(o, sj, ov, 2, err);
+    if (!lab) return false;
+    CurvePoint *c = calloc((size_t)nmaps + 1, sizeof *c), *target = NULL;
+    char note[1200] = "", curve_note[64] = "", end[1024];
+    int n = 0, ms = tech_param_index(sj->t, "map_size");
+    bool ok = c != NULL && ms >= 0;
+    if (!c) error_set(err, "out of memory");
+    else if (ms < 0) error_set(err, "%s has no map_size to sweep", sj->t->name);
+    for (int k = 0; ok && k < nmaps; k++) {
+        CurvePoint *cp = &c[n];
+        memcpy(cp->params, sj->params, sizeof cp->params);
+        cp->map_size = maps[k];
+        cp->params[ms] = maps[k];
+        Error refusal;
+        if (penumbra_error(o, lab, sj->t, cp, &refusal)) {
+            n++;
+        } else if (!note[0]) {
+            char why[1100];
+            snprintf(why, sizeof why, "map_size %d REFUSED (%s)", maps[k], refusal.msg);
+            bench_csv_field(note, sizeof note, why);
+            /* no comma: report.sh's plots split matched_curve.csv on commas */
+            snprintf(curve_note, sizeof curve_note, "map_size %d REFUSED (matched.csv says why)", maps[k]);
+            printf("  %-18s map_size %d REFUSED (%s)\n", sj->t->name, maps[k], refusal.msg);
+        }
+    }
+    if (ok && n == 0) ok = error_set(err, "%s refused every map size", sj->t->name);
+    if (ok) {
+        target = &c[n];
+        memcpy(target->params, base.params, sizeof target->params);
+        target->map_size = (int)base.params[tech_param_index(pcss, "map_size")];
+        ok = penumbra_error(o, lab, pcss, target, err);
+    }
+    if (ok) announce(o, sj, "matched");
+    for (int r = 0; ok && r < rounds; r++)
+        for (int k = 0; ok && k <= n; k++) {
+            Point p;
+            ok = measure(lab, k < n ? sj->t : pcss, c[k].params, 1, &p, err);
+            c[k].frame[r] = p.frame_s;
+            c[k].eval[r] = p.eval_s;
+        }
+    if (ok) where(sj, lab_scene(lab), o->c.threads, end, sizeof end);
+    for (int k = 0; ok && k < n; k++) {
+        char row[4096];
+        double f = bench_median(c[k].frame, rounds), e = bench_median(c[k].eval, rounds);
+        snprintf(row, sizeof row, "%s,%d,%.6f,%.6f,%ld,%.4f,%.4f,%s,%s", sj->t->name, c[k].map_size, c[k].rmse,
+                 c[k].noise_rms, c[k].samples, f * 1e3, e * 1e3, k == 0 ? curve_note : "", end);
+        printf("  %-18s map_size %4d: penumbra RMSE %.5f (reference noise %.5f, %ld samples), frame %9.3f ms\n",
+               sj->t->name, c[k].map_size, c[k].rmse, c[k].noise_rms, c[k].samples, f * 1e3);
+        ok = append(o, "matched_curve.csv", CURVE_HEADER, row, err);
+    }
+    if (ok) {
+        double ratio[2][64], at[2][64]; /* frame, evaluation */
+        const char *how = "no";
+        for (int r = 0; r < rounds; r++)
+            for (int e = 0; e < 2; e++) {
+                at[e][r] = time_at_rmse(c, n, r, e, target->rmse, &how);
+                ratio[e][r] = at[e][r] / (e ? target->eval[r] : target->frame[r]);
+            }
+        double pcss_ms = bench_median(target->frame, rounds) * 1e3;
+        double pcss_eval_ms = bench_median(target->eval, rounds) * 1e3;
+        double at_ms = bench_median(at[0], rounds) * 1e3, rt = bench_median(ratio[0], rounds);
+        double at_eval_ms = bench_median(at[1], rounds) * 1e3, rt_eval = bench_median(ratio[1], rounds);
+        char row[4096];
+        snprintf(row, sizeof row, "%s,%.6f,%.4f,%.4f,%.3f,%.4f,%.4f,%.3f,%s,%s,%s", sj->t->name, target->rmse, pcss_ms,
+                 at_ms, rt, pcss_eval_ms, at_eval_ms, rt_eval, how, note, end);
+        printf("  %-18s at pcss's penumbra RMSE %.5f (pcss %d^2, frame %.3f ms, eval %.3f ms): %sframe %.3f ms, "
+               "ratio %.3f; eval %.3f ms, ratio %.3f\n", sj->t->name, target->rmse, target->map_size, pcss_ms,
+               pcss_eval_ms,
+               reach_text(how), at_ms, rt, at_eval_ms, rt_eval);
+        ok = append(o, "matched.csv", MATCHED_HEADER, row, err);
+    }
+    free(c);
+    lab_close(lab);
+    return ok;
 }
 
 /* ---- thread scaling ------------------------------------------------------------ */
@@ -586,6 +968,10 @@ static bool bench_technique(const Options *o, const Technique *t)
     if (ok && part(o, "threads")) ok = scaling(o, &sj, &err);
     if (ok && part(o, "lightsize") && soft_on_spheres(t)) ok = light_size(o, &sj, &err);
     if (ok && part(o, "work")) ok = work_counts(o, &sj, &err);
+    if (ok && o->only && strcmp(o->only, "sweep") == 0 && (sweep_on_scene(o) || tech_param_index(t, o->axis) >= 0))
+        ok = sweep_cost(o, &sj, &err);
+    if (ok && o->only && strcmp(o->only, "matched") == 0 && (o->num_techs > 0 || in_matched_family(t->name)))
+        ok = matched(o, &sj, &err);
     if (sj.refused) printf("%s: %d growth point(s) REFUSED (growth.csv's note column says why)\n", t->name, sj.refused);
     if (!ok) fprintf(stderr, "techniques: %s: FAILED: %s\n", t->name, err.msg);
     return ok;
@@ -595,8 +981,9 @@ int main(int argc, char **argv)
 {
     Options o;
     if (!parse_options(argc, argv, &o))
-        return bench_usage("techniques [--only growth|constant|threads|lightsize|work] [-t TECH]... [-p NAME=VALUE]... "
-                           "[--threads N] [--repeat R] [--quick] [-o DIR] [SCENE]");
+        return bench_usage("techniques [--only growth|constant|threads|lightsize|work|sweep|matched] [-t TECH]... "
+                           "[-p NAME=VALUE]... [--sweep NAME=V1,V2,...] [--samples N] [--threads N] [--repeat R] "
+                           "[--quick] [-o DIR] [SCENE]");
     omp_set_num_threads(o.c.threads);
     rt_set_threads(o.c.threads);
     int failed = 0, run = 0;

@@ -46,14 +46,17 @@ static uint64_t entry_bytes(const Prefiltered *pf, int channels)
 
 static inline int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
 
+/* The refusal suggests precision=f32 only where it would fit: in f64 at no
+ * more than twice the cap (f32 halves the bytes). */
 static bool check_bytes(const char *what, int res, int faces, int channels, bool f64, size_t bytes, Error *err)
 {
     if (bytes <= PREFILTER_MAX_BYTES) return true;
+    bool f32_fits = f64 && bytes / 2 <= PREFILTER_MAX_BYTES;
     return error_set(err,
                      "%s of a %d^2 %d-face map with %d channels in %s needs %.2f GiB, above the %.0f GiB cap "
-                     "(use precision=f32, fewer channels or a smaller map_size)",
+                     "(use %sfewer channels or a smaller map_size)",
                      what, res, faces, channels, f64 ? "f64" : "f32", (double)bytes / (1 << 30),
-                     (double)PREFILTER_MAX_BYTES / (1 << 30));
+                     (double)PREFILTER_MAX_BYTES / (1 << 30), f32_fits ? "precision=f32, " : "");
 }
 
 /* ---- moment maps ---- */

@@ -432,3 +432,32 @@ TEST(test_filtered_techniques_are_finite_on_contacts)
     CHECK(techniques >= 6);
     lab_close(lab);
 }
+
+/* A moment map over PREFILTER_MAX_BYTES is refused before anything is read
+ * or allocated, and the refusal suggests precision=f32 only where halving
+ * the bytes brings it under the cap: cssm's 33 channels on a 2048^2 cube map
+ * need 6.19 GiB in f64 and 3.09 GiB in f32, so neither may suggest it. */
+TEST(test_moment_map_refusal_suggests_only_what_fits)
+{
+    ResourceManager *rm = rm_create();
+    CHECK(rm);
+    static const struct {
+        int res, faces, order;
+        bool f64, suggests_f32;
+    } cases[] = {
+        {2048, 6, 8, true, false},  /* 6.19 GiB: f32's 3.09 GiB is over the cap too */
+        {2048, 6, 8, false, false}, /* 3.09 GiB, already f32 */
+        {8192, 1, 1, true, true},   /* 5 channels: 2.50 GiB, f32 1.25 GiB fits */
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        ShadowMap map = {.res = cases[k].res, .num_faces = cases[k].faces};
+        MomentSpec spec = {.warp = WARP_FOURIER_DEPTH, .order = cases[k].order, .f64 = cases[k].f64};
+        Error err = {{0}};
+        CHECK(!res_moment_map(rm, &map, &spec, &err));
+        bool suggests = strstr(err.msg, "precision=f32") != NULL;
+        CHECK_MSG(strstr(err.msg, "above the 2 GiB cap") && suggests == cases[k].suggests_f32, "case %zu: %s", k,
+                  err.msg);
+        printf("    %s\n", err.msg);
+    }
+    rm_destroy(rm);
+}
