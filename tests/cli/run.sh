@@ -95,7 +95,7 @@ elif ! command -v python3 >/dev/null; then skip list_json_parses "no python3"; e
 value_for() {
     case $1 in
         NAME) echo hard ;; K=V | KEY=V) echo a=1 ;; DIR) echo "$TMP/unused" ;; P) echo r2 ;;
-        M) echo visibility ;; TEXT) echo x ;; *) echo 2 ;;
+        M) echo visibility ;; TEXT) echo x ;; SET) echo shared ;; *) echo 2 ;;
     esac
 }
 CMDS="list render reference compare aliasing stability"
