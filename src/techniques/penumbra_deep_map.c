@@ -1,0 +1,664 @@
+/* penumbra_deep_map.c -- `penumbra_deep_map`: penumbra deep shadow maps
+ * (St-Amour, Paquette & Poulin 2005, "Soft shadows from extended light
+ * sources with penumbra deep shadow maps", Graphics Interface 2005; course
+ * §5.2.4, its second paragraph). The N light samples' hard maps (multimap.h:
+ * the same points and map resources as `light_sampling`) are merged into one
+ * structure on the grid of the light centre's map: per texel, the
+ * visibility along the texel's centre ray as a function of depth,
+ *
+ *   V(z) = 1/N sum_k V_k(x(z)),  V_k = sample k's own depth test at x(z),
+ *
+ * x(z) the ray's point at linear depth z of the centre's face (course Eq.
+ * 1.4 by N-sample quadrature, as `light_sampling`, so V converges to it as
+ * the centre's texels shrink). V is a step function: V_k changes only at the
+ * visibility events, where the ray's image in sample k's map (its epipolar
+ * segment) enters another texel or passes that texel's stored depth. The
+ * build marches each segment at most half a texel of map k at a time
+ * (perspective-correct steps, so they are even in texels) and bisects each
+ * change of verdict down to PDM_REFINE halvings [derived]. Unlike a deep
+ * shadow map's transmittance (Lokovic & Veach 2000) V need not fall
+ * monotonically: past a caster smaller than the light a sample's segment
+ * clears the caster again and V rises [derived], so the functions are kept
+ * general, not monotone.
+ *
+ * Each texel's step function is compressed to a piecewise-linear one within
+ * `error` (max |deviation| in visibility), by Lokovic & Veach's greedy
+ * segment growth (Deep shadow maps, SIGGRAPH 2000, §4.2, as St-Amour et al.
+ * §4 use it): from a fixed origin, the interval of slopes that keeps the
+ * segment within error of every step end is narrowed until it empties;
+ * steps taller than 2 error become a jump (two vertices at one depth). So a
+ * staircase of equal steps 1/N compresses to one segment when error >=
+ * 1/(2N) [derived: a line through its mid-risers is within 1/(2N) of every
+ * step], and error = 0 keeps every event. A texel needing more than
+ * max_vertices is compressed again with the tolerance doubled until it fits
+ * (counted: the resource log's note).
+ *
+ * Lookup: the receiver's texel (nearest) or its four nearest (bilinear),
+ * each function evaluated at the receiver's plane depth on that texel's ray
+ * when receiver_plane is on (course §4.1.2 box: otherwise a texel's ray
+ * meets the receiver up to a texel's slope away and the functions drop to
+ * 0 there), less the shared bias, with the shared set-up (smap_receivers).
+ * Like `layered_attenuation`, V counts all N samples, also those below the
+ * receiver's tangent plane (the function is the ray's, not the surface's):
+ * it agrees with `light_sampling` off the terminator. The course's cost
+ * (§5.2.4): "rendering is real-time, but the build is interactive rates at
+ * best": the build reads about 2 N (segment length in texels) texels per
+ * texel of the centre's map. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "core/hash.h"
+#include "techniques/multimap.h"
+
+/* Bisections of a verdict change on the segment: its depth to 2^-12 of a
+ * half-texel step of map k. */
+#define PDM_REFINE 12
+#define PDM_MAX_VERTICES 1024
+/* A flat run this many times longer than the interval after the break it
+ * meets is a knee (compress): it ends flat rather than tilt toward a drop. */
+#define PDM_KNEE 4.0
+
+enum { P_SAMPLES = SMAP_NUM_PARAMS, P_PATTERN, P_ERROR, P_MAX_VERTICES, P_FILTER };
+enum { FILTER_NEAREST, FILTER_BILINEAR };
+static const char *const pdm_filter_names[] = {"nearest", "bilinear", NULL};
+
+static const ParamDesc pdm_params[] = {
+    /* cube faces at most, one cascade: the functions live on the centre map's grid */
+    SMAP_MAP_PARAMS_UPTO(MAP_PROJ_CUBE, 1, SPLIT_EXPLICIT),
+    SMAP_BIAS_PARAMS_PLANE(1),
+    LS_SAMPLE_PARAMS,
+    {"error", PARAM_FLOAT, 0.05, 0, 0.5, "visibility",
+     "compression bound: each texel's piecewise-linear function stays within this of its step function at every "
+     "depth (Lokovic & Veach 2000); 0 keeps every event; a staircase of N steps becomes one segment from 1/(2N)",
+     NULL},
+    {"max_vertices", PARAM_INT, 32, 2, PDM_MAX_VERTICES, "vertices",
+     "vertex cap per texel: a function needing more is compressed again with the bound doubled until it fits "
+     "(counted); memory is at most faces x map_size^2 x (8 max_vertices + 5) bytes, refused above 2 GiB",
+     NULL},
+    {"filter", PARAM_ENUM, FILTER_NEAREST, 0, 1, "",
+     "lookup: the receiver's texel's function (nearest), or the four nearest texels' functions, each at the "
+     "receiver's depth on its own ray, weighted bilinearly",
+     pdm_filter_names},
+};
+
+static const char *const pdm_resources[] = {"shadow_map", "penumbra_deep_map", "view_samples", NULL};
+static const char *const pdm_aux[] = {"vertices", NULL};
+
+/* ---- the step function of one texel's ray --------------------------------- */
+
+/* A change of one sample's verdict at depth z: +1 lit, -1 shadowed. */
+typedef struct Event {
+    float z;
+    int delta;
+} Event;
+
+/* Per-thread scratch of the build. */
+typedef struct Scratch {
+    Event *event;
+    int count, cap;
+    float *zb, *c;      /* the step function: breaks zb[0..m+1], values c[0..m] */
+    DeepVertex *out;    /* its compression */
+} Scratch;
+
+/* Room for `cap` events and the step function and compression they make. */
+static bool scratch_grow(Scratch *s, int cap)
+{
+    Event *e = realloc(s->event, (size_t)cap * sizeof *e);
+    if (e) s->event = e;
+    float *zb = realloc(s->zb, (size_t)(cap + 2) * sizeof *zb);
+    if (zb) s->zb = zb;
+    float *c = realloc(s->c, (size_t)(cap + 1) * sizeof *c);
+    if (c) s->c = c;
+    DeepVertex *o = realloc(s->out, (size_t)(2 * cap + 2) * sizeof *o); /* compress: at most 2 per break + 2 */
+    if (o) s->out = o;
+    if (!e || !zb || !c || !o) return false;
+    s->cap = cap;
+    return true;
+}
+
+static bool push_event(Scratch *s, float z, int delta)
+{
+    if (s->count == s->cap && !scratch_grow(s, 2 * s->cap)) return false;
+    s->event[s->count++] = (Event){z, delta};
+    return true;
+}
+
+/* Sample k's depth test at world point x (the test of course §2.1 in the
+ * map's stored metric): 1 lit, 0 shadowed, NaN unknown; lit off the map. */
+static float verdict(const ShadowMap *m, dvec3 x)
+{
+    MapCoord mc = lightview_locate(&m->view, x);
+    if (!mc.inside) return 1.0f;
+    int i = (int)mc.s, j = (int)mc.t;
+    i = i < m->res ? i : m->res - 1; /* s < res, but rounding may reach it */
+    j = j < m->res ? j : m->res - 1;
+    double ref = m->spec.depth == RASTER_DEPTH_NDC ? mc.z_ndc : mc.depth_linear;
+    return smap_test(ref, shadowmap_texel(m, mc.face, i, j));
+}
+
+/* One sample's map and what bounds its march. */
+typedef struct SampleMap {
+    const ShadowMap *map;
+    dvec3 point;       /* the sample, world */
+    double lit_within; /* points nearer the sample than this see it (the map's nearest stored depth) */
+} SampleMap;
+
+/* The ray's parameter u in [0, 1] (a + u (b - a)) at screen parameter lam of
+ * the segment's image: perspective-correct interpolation with depths wa, wb
+ * (1 for ortho faces), so even steps in lam are even in texels. */
+static double ray_u(double lam, double wa, double wb)
+{
+    double den = (1.0 - lam) * wb + lam * wa;
+    return den > 0.0 ? lam * wa / den : lam;
+}
+
+/* Where the segment a-b leaves the ball of radius r about c (0: it starts
+ * outside; 1: it never leaves). */
+static double leave_ball(dvec3 a, dvec3 b, dvec3 c, double r)
+{
+    dvec3 d = d3_sub(b, a), f = d3_sub(a, c);
+    double A = d3_dot(d, d), B = d3_dot(f, d), C = d3_dot(f, f) - r * r;
+    if (!(C < 0.0) || !(A > 0.0)) return 0.0;
+    double u = (-B + sqrt(B * B - A * C)) / A; /* the far root: C < 0, so real */
+    return u < 1.0 ? u : 1.0;
+}
+
+/* The events of sample `s` on the segment a-b (depths za..zb along the
+ * centre's axis); false when a verdict is NaN (the texel is unknown). */
+static bool sample_events(const SampleMap *s, dvec3 a, dvec3 b, double za, double zb, Scratch *sc, int *lit0,
+                          bool *oom)
+{
+    double u0 = leave_ball(a, b, s->point, s->lit_within);
+    dvec3 a0 = d3_madd(a, d3_sub(b, a), u0);
+    MapCoord ca = lightview_locate(&s->map->view, a0), cb = lightview_locate(&s->map->view, b);
+    const MapFace *fa = &s->map->view.face[ca.face];
+    double len, wa = 1.0, wb = 1.0;
+    if (ca.face == cb.face && ca.inside && cb.inside) {
+        len = hypot(cb.s - ca.s, cb.t - ca.t);
+        if (fa->perspective) wa = ca.depth_linear, wb = cb.depth_linear;
+    } else { /* across cube faces or off the map: chord steps, a cube face's at most res texels per radian */
+        dvec3 da = d3_sub(a0, s->point), db = d3_sub(b, s->point);
+        wa = d3_len(da), wb = d3_len(db);
+        double ang = wa > 0.0 && wb > 0.0 ? acos(fmax(-1.0, fmin(1.0, d3_dot(da, db) / (wa * wb)))) : 0.0;
+        len = ang * s->map->res;
+    }
+    int steps = (int)fmin(ceil(2.0 * len), 8.0 * s->map->res) + 1;
+    float prev = verdict(s->map, a0);
+    if (isnan(prev)) return false;
+    *lit0 += u0 > 0.0 ? 1 : (int)prev; /* inside the ball it is lit */
+    if (u0 > 0.0 && prev == 0.0f && !push_event(sc, (float)(za + u0 * (zb - za)), -1)) return *oom = true;
+    double lam_prev = 0.0;
+    for (int q = 1; q <= steps; q++) {
+        double lam = (double)q / steps;
+        float v = verdict(s->map, d3_madd(a0, d3_sub(b, a0), ray_u(lam, wa, wb)));
+        if (isnan(v)) return false;
+        if (v != prev) { /* bisect [lam_prev, lam] for the change */
+            double lo = lam_prev, hi = lam;
+            for (int r = 0; r < PDM_REFINE; r++) {
+                double mid = 0.5 * (lo + hi);
+                float vm = verdict(s->map, d3_madd(a0, d3_sub(b, a0), ray_u(mid, wa, wb)));
+                if (isnan(vm)) return false;
+                if (vm == prev) lo = mid;
+                else hi = mid;
+            }
+            double u = u0 + (1.0 - u0) * ray_u(hi, wa, wb);
+            if (!push_event(sc, (float)(za + u * (zb - za)), v > prev ? 1 : -1)) return *oom = true;
+            prev = v;
+        }
+        lam_prev = lam;
+    }
+    return true;
+}
+
+static int event_cmp(const void *pa, const void *pb)
+{
+    const Event *a = pa, *b = pb;
+    return (a->z > b->z) - (a->z < b->z);
+}
+
+/* The step function from the events: breaks zb[1..m] strictly inside
+ * (zb[0], zb[m+1]) = (za, zf), value c[i] / n on [zb[i], zb[i+1]); events at
+ * one depth merge, and breaks where nothing changes go. Returns m. */
+static int step_function(Scratch *s, int lit0, int n, float za, float zf)
+{
+    qsort(s->event, (size_t)s->count, sizeof *s->event, event_cmp);
+    int m = 0, lit = lit0;
+    s->zb[0] = za;
+    s->c[0] = (float)lit0 / (float)n;
+    for (int e = 0; e < s->count;) {
+        float z = s->event[e].z;
+        int change = 0;
+        for (; e < s->count && s->event[e].z == z; e++) change += s->event[e].delta;
+        lit += change;
+        if (!(z > za && z < zf)) { /* at the ends (rounding): the value from there on */
+            if (z <= za) s->c[0] = (float)lit / (float)n;
+            continue;
+        }
+        if (change == 0) continue;
+        m++;
+        s->zb[m] = z;
+        s->c[m] = (float)lit / (float)n;
+    }
+    s->zb[m + 1] = zf;
+    return m;
+}
+
+/* Break i's window [lo, hi]: within eps of value c, inside [0, 1]. */
+static void window(double c, double eps, double *lo, double *hi)
+{
+    *lo = c - eps > 0.0 ? c - eps : 0.0;
+    *hi = c + eps < 1.0 ? c + eps : 1.0;
+}
+
+/* Interval i's length [zb[i], zb[i + 1]). */
+static double span(const float *zb, int i) { return (double)zb[i + 1] - zb[i]; }
+
+/* The value a segment from (zb[a], ya) ends with at break i, its slope in
+ * [lo, hi]: the one nearest the value of the longer interval beside the
+ * break. Receivers read there: on the flat run in front of their surface's
+ * drop (the N maps disagree on the surface's depth by about a texel's
+ * slope, so the drop is a short staircase), or on a long run behind a
+ * caster (the umbra). [derived: with the middle slope, as Lokovic & Veach
+ * choose, the lit ground of sphere-on-plane read 0.9 eps too dark.] */
+static double end_value(const float *zb, const float *c, int m, int i, int a, double ya, double lo, double hi)
+{
+    double dz = (double)zb[i] - zb[a];
+    double target = i > m ? c[m] : span(zb, i) > span(zb, i - 1) ? c[i] : c[i - 1];
+    double slope = (target - ya) / dz;
+    slope = slope < lo ? lo : slope > hi ? hi : slope;
+    return ya + slope * dz;
+}
+
+/* Lokovic & Veach's greedy compression (Deep shadow maps §4.2) of the step
+ * function (zb, c, m) within eps into `out`; returns the vertex count. A
+ * segment from (zb[a], ya) may end at break i when some slope keeps it
+ * within eps of c[i - 1] there, and pass through i when also of c[i] (the
+ * deviation of a line from a constant is largest at an interval's ends, so
+ * the ends bound it everywhere); [lo, hi] is the slopes that pass every
+ * break so far. Where no slope passes, the segment ends at i and jumps to
+ * c[i]; where break i is out of reach, it ends at i - 1 and the next one
+ * starts there. A long flat run meeting short intervals (a knee: the top of
+ * a drop) ends flat there rather than tilt toward the drop [derived, as
+ * end_value]. */
+static int compress(const float *zb, const float *c, int m, double eps, DeepVertex *out)
+{
+    int k = 0, a = 0;
+    double ya = c[0], lo = -INFINITY, hi = INFINITY;
+    out[k++] = (DeepVertex){zb[0], (float)ya};
+    for (int i = 1; i <= m + 1;) {
+        double dz = (double)zb[i] - zb[a]; /* > 0: the breaks increase strictly */
+        double wlo, whi;
+        window(c[i - 1], eps, &wlo, &whi);
+        double elo = fmax(lo, (wlo - ya) / dz), ehi = fmin(hi, (whi - ya) / dz);
+        if (elo > ehi) { /* out of reach: end at i - 1 (i - 1 > a, so lo and hi are finite) */
+            ya = end_value(zb, c, m, i - 1, a, ya, lo, hi);
+            a = i - 1;
+            out[k++] = (DeepVertex){zb[a], (float)ya};
+            lo = -INFINITY, hi = INFINITY;
+            continue;
+        }
+        double plo = 1.0, phi = 0.0; /* the slopes passing break i: none at the end */
+        if (i <= m) {
+            window(c[i], eps, &wlo, &whi);
+            plo = fmax(elo, (wlo - ya) / dz), phi = fmin(ehi, (whi - ya) / dz);
+        }
+        bool knee = i <= m && elo <= 0.0 && ehi >= 0.0 && !(plo <= 0.0 && phi >= 0.0) &&
+                    dz > PDM_KNEE * span(zb, i);
+        if (plo <= phi && !knee) {
+            lo = plo, hi = phi, i++;
+            continue;
+        }
+        double y = knee ? ya : end_value(zb, c, m, i, a, ya, elo, ehi); /* a knee ends flat */
+        out[k++] = (DeepVertex){zb[i], (float)y};
+        if (i <= m && (float)y != c[i]) out[k++] = (DeepVertex){zb[i], c[i]}; /* the jump */
+        a = i, ya = c[i <= m ? i : m], lo = -INFINITY, hi = INFINITY;
+        if (i <= m && (float)y == c[i]) ya = y;
+        i++;
+    }
+    return k;
+}
+
+/* ---- the resource ----------------------------------------------------------- */
+
+typedef struct DeepArgs {
+    const ShadowMap *centre;
+    dvec3 box_min, box_max; /* the scene's bounds, a little enlarged: receivers lie inside */
+    const SampleMap *sample;
+    int n, max_vertices;
+    double error;
+} DeepArgs;
+
+/* The part [*u0, *u1] of the segment a + u (b - a), u in [0, 1], inside the
+ * box (the slab method); false when it misses. */
+static bool clip_to_box(dvec3 a, dvec3 b, dvec3 lo, dvec3 hi, double *u0, double *u1)
+{
+    const double o[3] = {a.x, a.y, a.z}, d[3] = {b.x - a.x, b.y - a.y, b.z - a.z};
+    const double l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
+    *u0 = 0.0, *u1 = 1.0;
+    for (int k = 0; k < 3; k++) {
+        if (d[k] == 0.0) {
+            if (o[k] < l[k] || o[k] > h[k]) return false;
+            continue;
+        }
+        double ta = (l[k] - o[k]) / d[k], tb = (h[k] - o[k]) / d[k];
+        *u0 = fmax(*u0, fmin(ta, tb));
+        *u1 = fmin(*u1, fmax(ta, tb));
+    }
+    return *u0 < *u1;
+}
+
+/* One texel's function into sc->out over the part of its centre ray inside
+ * the scene's bounds (held constant beyond); returns the vertex count, 0
+ * unknown (a NaN verdict), -1 out of memory. */
+static int texel_function(const DeepArgs *d, int face, int i, int j, Scratch *sc, long *events, bool *capped)
+{
+    const LightView *v = &d->centre->view;
+    const RasterView *rv = &v->face[face].raster;
+    dvec3 a, b;
+    double u0, u1;
+    *capped = false;
+    if (!mm_texel_point(v, face, i + 0.5, j + 0.5, rv->depth_near, &a) ||
+        !mm_texel_point(v, face, i + 0.5, j + 0.5, rv->depth_far, &b))
+        return 0;
+    if (!clip_to_box(a, b, d->box_min, d->box_max, &u0, &u1)) { /* nothing to shadow or be shadowed: lit */
+        sc->out[0] = (DeepVertex){(float)rv->depth_near, 1.0f};
+        return 1;
+    }
+    double za = rv->depth_near + u0 * (rv->depth_far - rv->depth_near);
+    double zb = rv->depth_near + u1 * (rv->depth_far - rv->depth_near);
+    dvec3 ca = d3_madd(a, d3_sub(b, a), u0), cb = d3_madd(a, d3_sub(b, a), u1);
+    sc->count = 0;
+    int lit0 = 0;
+    bool oom = false;
+    for (int k = 0; k < d->n; k++) {
+        if (!sample_events(&d->sample[k], ca, cb, za, zb, sc, &lit0, &oom)) return 0;
+        if (oom) return -1;
+    }
+    int m = step_function(sc, lit0, d->n, (float)za, (float)zb);
+    *events += m;
+    double eps = d->error;
+    int k = compress(sc->zb, sc->c, m, eps, sc->out);
+    while (k > d->max_vertices) { /* [derived] eps = 0.5 leaves one segment at 1/2: two vertices */
+        *capped = true;
+        eps = fmin(0.5, fmax(2.0 * eps, 0.25 / d->n));
+        k = compress(sc->zb, sc->c, m, eps, sc->out);
+    }
+    return k;
+}
+
+static size_t deep_bytes(const void *res)
+{
+    const DeepMap *d = res;
+    return d->texels * (sizeof *d->first + sizeof *d->unknown) + sizeof *d->first +
+           (size_t)d->first[d->texels] * sizeof *d->vertex;
+}
+
+static void deep_destroy(void *res)
+{
+    DeepMap *d = res;
+    if (!d) return;
+    free(d->first);
+    free(d->vertex);
+    free(d->unknown);
+    free(d);
+}
+
+static const ResourceKind kind_deep_map = {"penumbra_deep_map", deep_bytes, deep_destroy, RES_FRAME};
+
+/* Row buffers of the build, joined in order (thread-count independent). */
+typedef struct Row {
+    DeepVertex *vertex;
+    uint32_t count;
+} Row;
+
+static bool build_rows(const DeepArgs *a, DeepMap *d, uint16_t *count, Row *row)
+{
+    int res = d->res, rows = d->num_faces * res;
+    long events = 0, capped = 0;
+    bool ok = true;
+#pragma omp parallel reduction(+ : events, capped) reduction(&& : ok)
+    {
+        Scratch sc = {0};
+        bool grown = scratch_grow(&sc, 256);
+        DeepVertex *buf = malloc((size_t)res * (size_t)a->max_vertices * sizeof *buf);
+        ok = grown && buf;
+#pragma omp for schedule(dynamic, 1)
+        for (int r = 0; r < rows; r++) {
+            int f = r / res, j = r % res;
+            uint32_t used = 0;
+            for (int i = 0; ok && i < res; i++) {
+                bool cap;
+                size_t t = ((size_t)f * res + j) * res + i;
+                int k = texel_function(a, f, i, j, &sc, &events, &cap);
+                if (k < 0) ok = false;
+                if (k <= 0) {
+                    d->unknown[t] = 1, count[t] = 0;
+                    continue;
+                }
+                capped += cap;
+                memcpy(buf + used, sc.out, (size_t)k * sizeof *buf);
+                count[t] = (uint16_t)k;
+                used += (uint32_t)k;
+            }
+            row[r].count = used;
+            row[r].vertex = ok ? malloc((used ? used : 1) * sizeof *buf) : NULL;
+            if (row[r].vertex) memcpy(row[r].vertex, buf, used * sizeof *buf);
+            else ok = false;
+        }
+        free(buf);
+        free(sc.event), free(sc.zb), free(sc.c), free(sc.out);
+    }
+    d->events = events;
+    d->capped = capped;
+    return ok;
+}
+
+static void *build_deep_map(const void *args, Error *err)
+{
+    const DeepArgs *a = args;
+    const ShadowMap *c = a->centre;
+    DeepMap *d = calloc(1, sizeof *d);
+    size_t texels = (size_t)c->num_faces * (size_t)c->res * (size_t)c->res;
+    int rows = c->num_faces * c->res;
+    uint16_t *count = calloc(texels, sizeof *count);
+    Row *row = calloc((size_t)rows, sizeof *row);
+    if (d) *d = (DeepMap){a->n, a->error, a->max_vertices, c->res, c->num_faces, texels, NULL, NULL, NULL, 0, 0};
+    bool ok = d && count && row && (d->first = malloc((texels + 1) * sizeof *d->first)) &&
+              (d->unknown = calloc(texels, 1)) && build_rows(a, d, count, row);
+    size_t total = 0;
+    for (int r = 0; ok && r < rows; r++) total += row[r].count;
+    if (ok && (d->vertex = malloc((total ? total : 1) * sizeof *d->vertex))) {
+        size_t at = 0;
+        for (int r = 0; r < rows; r++) {
+            memcpy(d->vertex + at, row[r].vertex, row[r].count * sizeof *d->vertex);
+            at += row[r].count;
+        }
+        d->first[0] = 0;
+        for (size_t t = 0; t < texels; t++) d->first[t + 1] = d->first[t] + count[t];
+    } else {
+        ok = false;
+    }
+    for (int r = 0; row && r < rows; r++) free(row[r].vertex);
+    free(row);
+    free(count);
+    if (ok) return d;
+    if (d) deep_destroy(d);
+    error_set(err, "out of memory building the penumbra deep shadow map (%zu texels)", texels);
+    return NULL;
+}
+
+/* The bound checked before any map is drawn: every texel at the cap. */
+static bool deep_check(size_t texels, int max_vertices, int res, Error *err)
+{
+    double bytes = (double)texels * (max_vertices * (double)sizeof(DeepVertex) + sizeof(uint32_t) + 1.0);
+    if (bytes <= (double)SHADOWMAP_MAX_BYTES) return true;
+    return error_set(err, "max_vertices = %d at map_size = %d take up to %.2f GiB, above the %.0f GiB limit: lower "
+                          "max_vertices or map_size",
+                     max_vertices, res, bytes / (1u << 30), (double)SHADOWMAP_MAX_BYTES / (1u << 30));
+}
+
+/* The nearest finite stored depth of a map as a distance from its light
+ * (linear depth along a face's axis is at most the distance), or 0 when a
+ * NaN texel must be marched to. */
+static double nearest_stored(const ShadowMap *m)
+{
+    double best = INFINITY;
+    for (int f = 0; f < m->num_faces; f++)
+        for (int j = 0; j < m->res; j++) {
+            const float *row = shadowmap_row(m, f, j, m->res);
+            for (int i = 0; i < m->res; i++) {
+                if (isnan(row[i])) return 0.0;
+                best = fmin(best, smap_linear_depth(m, f, row[i]));
+            }
+        }
+    return isfinite(best) ? best * (1.0 - 1e-6) : 0.0; /* the margin: locate's rounding */
+}
+
+typedef struct PdmState {
+    SmapBias bias;
+    const ShadowMap *centre;
+    const DeepMap *deep;
+    bool bilinear;
+} PdmState;
+
+static const DeepMap *acquire_deep_map(const TechContext *ctx, DeepArgs *a, Error *err)
+{
+    Hasher h;
+    hash_init(&h);
+    hash_str(&h, "penumbra deep map 1");
+    hash_u64(&h, a->centre->key);
+    for (int k = 0; k < a->n; k++) hash_u64(&h, a->sample[k].map->key);
+    hash_f64(&h, a->error);
+    hash_f64(&h, a->max_vertices);
+    uint64_t key = hash_final(&h);
+    char desc[160];
+    snprintf(desc, sizeof desc, "light %d, %d samples, %d^2 x %d faces, error %g, cap %d", ctx->light_index + 1, a->n,
+             a->centre->res, a->centre->num_faces, a->error, a->max_vertices);
+    const DeepMap *d = rm_acquire(ctx->rm, &kind_deep_map, key, desc, build_deep_map, a, err);
+    if (!d) return NULL;
+    char note[160];
+    snprintf(note, sizeof note, "%ld events, %u vertices (%.2f per texel, %.1f MiB), %ld texels capped", d->events,
+             d->first[d->texels], (double)d->first[d->texels] / (double)d->texels,
+             (double)d->first[d->texels] * sizeof(DeepVertex) / (1u << 20), d->capped);
+    rm_log_note(ctx->rm, kind_deep_map.name, key, note);
+    return d;
+}
+
+static bool pdm_prepare(const TechContext *ctx, void **state, Error *err)
+{
+    const double *p = ctx->params;
+    PdmState *st = calloc(1, sizeof *st);
+    const ShadowMap **map = calloc(LS_MAX_SAMPLES, sizeof *map);
+    vec3 *point = calloc(LS_MAX_SAMPLES, sizeof *point);
+    SampleMap *sample = calloc(LS_MAX_SAMPLES, sizeof *sample);
+    if (!st || !map || !point || !sample) {
+        free(st), free(map), free(point), free(sample);
+        return error_set(err, "out of memory");
+    }
+    st->bias = smap_bias(p, ctx->scene);
+    st->bilinear = (int)p[P_FILTER] == FILTER_BILINEAR;
+    ShadowMapSpec spec = smap_spec(p);
+    Light probe = {.kind = LIGHT_POINT, .position = ctx->light->position};
+    size_t most_texels = shadowmap_bytes_for(&probe, &spec) / sizeof(float);
+    dvec3 margin = d3_from(v3(1.0f, 1.0f, 1.0f));
+    margin = d3_scale(margin, 1e-3 * scene_extent(ctx->scene));
+    DeepArgs a = {.box_min = d3_sub(d3_from(ctx->scene->bounds_min), margin),
+                  .box_max = d3_add(d3_from(ctx->scene->bounds_max), margin), .sample = sample, .n = (int)p[P_SAMPLES], .max_vertices = (int)p[P_MAX_VERTICES],
+                  .error = p[P_ERROR]};
+    bool ok = deep_check(most_texels, a.max_vertices, spec.res, err) &&
+              ls_sample_maps(ctx, &spec, a.n, (int)p[P_PATTERN], point, map, err) &&
+              (a.centre = ls_point_map(ctx, &spec, ctx->light->position, err));
+    for (int k = 0; ok && k < a.n; k++)
+        sample[k] = (SampleMap){map[k], d3_from(point[k]), nearest_stored(map[k])};
+    ok = ok && (st->deep = acquire_deep_map(ctx, &a, err));
+    st->centre = a.centre;
+    free(map), free(point), free(sample);
+    if (!ok) {
+        free(st);
+        return false;
+    }
+    *state = st;
+    return true;
+}
+
+/* A texel's function at depth z (right-continuous at a step; held beyond
+ * the ends), reading its vertices up to z. */
+static float deep_value(const DeepMap *d, size_t t, double z)
+{
+    if (d->unknown[t] || isnan(z)) return NAN;
+    const DeepVertex *v = d->vertex + d->first[t];
+    int n = (int)(d->first[t + 1] - d->first[t]), k = 0;
+    while (k < n && v[k].z <= z) k++;
+    work_texels((uint64_t)(k < n ? k + 1 : n), sizeof *v); /* the vertices read (core/counters.h) */
+    if (k == 0) return v[0].v;
+    if (k == n) return v[n - 1].v;
+    double w = (z - v[k - 1].z) / ((double)v[k].z - v[k - 1].z); /* v[k].z > z >= v[k - 1].z */
+    return (float)(v[k - 1].v + w * ((double)v[k].v - v[k - 1].v));
+}
+
+/* Texel (i, j) of the receiver's face at the receiver's (plane) depth there,
+ * linear along the face's axis. */
+static float texel_at(const PdmState *st, const SmapReceiver *r, int i, int j)
+{
+    int res = st->deep->res;
+    i = i < 0 ? 0 : i >= res ? res - 1 : i;
+    j = j < 0 ? 0 : j >= res ? res - 1 : j;
+    size_t t = ((size_t)r->mc.face * res + j) * res + i;
+    return deep_value(st->deep, t, smap_linear_depth(st->centre, r->mc.face, smap_ref_at(r, i, j)));
+}
+
+static float pdm_visibility(const PdmState *st, const SmapReceiver *r, float *vertices)
+{
+    int i, j, res = st->deep->res;
+    smap_texel(r, &i, &j);
+    i = i < res ? i : res - 1;
+    j = j < res ? j : res - 1;
+    size_t t = ((size_t)r->mc.face * res + j) * res + i;
+    *vertices = (float)(st->deep->first[t + 1] - st->deep->first[t]);
+    if (!st->bilinear) return texel_at(st, r, i, j);
+    double s = r->mc.s - 0.5, u = r->mc.t - 0.5, fs = s - floor(s), ft = u - floor(u);
+    int i0 = (int)floor(s), j0 = (int)floor(u);
+    double v0 = (1.0 - fs) * texel_at(st, r, i0, j0) + fs * texel_at(st, r, i0 + 1, j0);
+    double v1 = (1.0 - fs) * texel_at(st, r, i0, j0 + 1) + fs * texel_at(st, r, i0 + 1, j0 + 1);
+    return (float)((1.0 - ft) * v0 + ft * v1);
+}
+
+static void pdm_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
+{
+    const PdmState *st = state;
+    SmapReceiver r[SMAP_BATCH];
+    bool inside[SMAP_BATCH];
+    for (int s0 = begin; s0 < end; s0 += SMAP_BATCH) {
+        int count = end - s0 < SMAP_BATCH ? end - s0 : SMAP_BATCH;
+        smap_receivers(st->centre, &st->bias, ctx->vs->p_world + s0, ctx->vs->n_geom_world + s0, ctx->cls + s0,
+                       count, r, inside);
+        for (int q = 0; q < count; q++) {
+            int s = s0 + q;
+            if (ctx->cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+            float vertices = 0.0f;
+            float v = inside[q] ? pdm_visibility(st, &r[q], &vertices) : 1.0f; /* off the map: lit, as light_sampling */
+            tech_store(ctx, out, begin, s, v);
+            if (ctx->aux) ctx->aux[s] = vertices;
+        }
+    }
+}
+
+const Technique tech_penumbra_deep_map = {
+    .name = "penumbra_deep_map",
+    .family = "soft",
+    .source = "course §5.2.4 (St-Amour, Paquette & Poulin 2005, penumbra deep shadow maps; compression of Lokovic "
+              "& Veach 2000)",
+    .summary = "per texel of the light centre's map, the fraction of N light samples' hard maps that see each depth "
+               "of its ray, marched through their texels and compressed to a piecewise-linear function within "
+               "`error`; V = that function at the receiver's depth",
+    .params = pdm_params,
+    .num_params = (int)(sizeof pdm_params / sizeof pdm_params[0]),
+    .resources = pdm_resources,
+    .aux = pdm_aux,
+    .rgb = false,
+    .lights = LIGHT_BIT(LIGHT_SPHERE) | LIGHT_BIT(LIGHT_DISK) | LIGHT_BIT(LIGHT_RECT),
+    .main_param = "samples",
+    .prepare = pdm_prepare,
+    .evaluate = pdm_evaluate,
+    .release = free,
+};
