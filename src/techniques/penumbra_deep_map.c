@@ -125,17 +125,64 @@ static bool push_event(Scratch *s, float z, int delta)
     return true;
 }
 
-/* Sample k's depth test at world point x (the test of course §2.1 in the
- * map's stored metric): 1 lit, 0 shadowed, NaN unknown; lit off the map. */
-static float verdict(const ShadowMap *m, dvec3 x)
+/* Sample k's depth test (course §2.1, in the map's stored metric) of the
+ * located point mc: 1 lit, 0 shadowed, NaN unknown; lit off the map. */
+static float verdict_at(const ShadowMap *m, const MapCoord *mc)
 {
-    MapCoord mc = lightview_locate(&m->view, x);
-    if (!mc.inside) return 1.0f;
-    int i = (int)mc.s, j = (int)mc.t;
+    if (!mc->inside) return 1.0f;
+    int i = (int)mc->s, j = (int)mc->t;
     i = i < m->res ? i : m->res - 1; /* s < res, but rounding may reach it */
     j = j < m->res ? j : m->res - 1;
-    double ref = m->spec.depth == RASTER_DEPTH_NDC ? mc.z_ndc : mc.depth_linear;
-    return smap_test(ref, shadowmap_texel(m, mc.face, i, j));
+    double ref = m->spec.depth == RASTER_DEPTH_NDC ? mc->z_ndc : mc->depth_linear;
+    return smap_test(ref, shadowmap_texel(m, mc->face, i, j));
+}
+
+/* A segment a + u (b - a) of world space seen through one face of sample
+ * k's map: on a plain (ortho, perspective or cube) face its clip
+ * coordinates and linear depth are affine in u, so a point is located as
+ * lightview_locate_on does, without the matrices; `fast` false when the
+ * segment spans faces (located per point). */
+typedef struct Seg {
+    const ShadowMap *map;
+    dvec3 a, ab;
+    bool fast;
+    int face;
+    dvec4 c0, dc; /* clip coordinates at u = 0, their change to u = 1 */
+    double d0, dd; /* linear depth likewise */
+} Seg;
+
+static Seg seg_make(const ShadowMap *m, dvec3 a, dvec3 b, int face_a, int face_b)
+{
+    Seg g = {.map = m, .a = a, .ab = d3_sub(b, a), .fast = face_a == face_b, .face = face_a};
+    const MapFace *f = &m->view.face[face_a];
+    const double *row = f->raster.depth_row;
+    dvec4 ca = m4_apply(&f->raster.clip_from_world, a), cb = m4_apply(&f->raster.clip_from_world, b);
+    g.c0 = ca;
+    g.dc = (dvec4){cb.x - ca.x, cb.y - ca.y, cb.z - ca.z, cb.w - ca.w};
+    g.d0 = row[0] * a.x + row[1] * a.y + row[2] * a.z + row[3];
+    g.dd = row[0] * g.ab.x + row[1] * g.ab.y + row[2] * g.ab.z;
+    return g;
+}
+
+/* The verdict at u: lightview_locate_on's arithmetic (lightview_lookup.c)
+ * on the segment's face, or lightview_locate. */
+static float seg_verdict(const Seg *g, double u)
+{
+    const ShadowMap *m = g->map;
+    if (!g->fast) {
+        MapCoord mc = lightview_locate(&m->view, d3_madd(g->a, g->ab, u));
+        return verdict_at(m, &mc);
+    }
+    double w = g->c0.w + u * g->dc.w;
+    MapCoord mc = {.face = g->face, .depth_linear = g->d0 + u * g->dd};
+    if (w > 0.0) {
+        mc.s = ((g->c0.x + u * g->dc.x) / w + 1.0) * 0.5 * m->res;
+        mc.t = ((g->c0.y + u * g->dc.y) / w + 1.0) * 0.5 * m->res;
+        mc.z_ndc = (g->c0.z + u * g->dc.z) / w;
+        mc.inside = mc.s >= 0.0 && mc.s < m->res && mc.t >= 0.0 && mc.t < m->res && mc.z_ndc >= 0.0 &&
+                    mc.z_ndc <= 1.0;
+    }
+    return verdict_at(m, &mc);
 }
 
 /* One sample's map and what bounds its march. */
@@ -165,40 +212,51 @@ static double leave_ball(dvec3 a, dvec3 b, dvec3 c, double r)
     return u < 1.0 ? u : 1.0;
 }
 
+/* Steps of the segment's image in texels: from the face's clip coordinates
+ * when it lies on one face in front of the eye, else (across cube faces)
+ * the angle it spans, a cube face having at most res texels per radian. */
+static double seg_texels(const Seg *g, dvec3 point)
+{
+    double wa = g->c0.w, wb = g->c0.w + g->dc.w, res = g->map->res;
+    if (g->fast && wa > 0.0 && wb > 0.0)
+        return 0.5 * res * hypot((g->c0.x + g->dc.x) / wb - g->c0.x / wa, (g->c0.y + g->dc.y) / wb - g->c0.y / wa);
+    dvec3 da = d3_sub(g->a, point), db = d3_add(da, g->ab);
+    double la = d3_len(da), lb = d3_len(db);
+    return la > 0.0 && lb > 0.0 ? acos(fmax(-1.0, fmin(1.0, d3_dot(da, db) / (la * lb)))) * res : res;
+}
+
 /* The events of sample `s` on the segment a-b (depths za..zb along the
- * centre's axis); false when a verdict is NaN (the texel is unknown). */
+ * centre's axis); false when a verdict is NaN (the texel is unknown). The
+ * steps are perspective-correct on a face (depths wa, wb: even in texels),
+ * else along the chord of directions from the sample. */
 static bool sample_events(const SampleMap *s, dvec3 a, dvec3 b, double za, double zb, Scratch *sc, int *lit0,
                           bool *oom)
 {
     double u0 = leave_ball(a, b, s->point, s->lit_within);
     dvec3 a0 = d3_madd(a, d3_sub(b, a), u0);
-    MapCoord ca = lightview_locate(&s->map->view, a0), cb = lightview_locate(&s->map->view, b);
-    const MapFace *fa = &s->map->view.face[ca.face];
-    double len, wa = 1.0, wb = 1.0;
-    if (ca.face == cb.face && ca.inside && cb.inside) {
-        len = hypot(cb.s - ca.s, cb.t - ca.t);
-        if (fa->perspective) wa = ca.depth_linear, wb = cb.depth_linear;
-    } else { /* across cube faces or off the map: chord steps, a cube face's at most res texels per radian */
-        dvec3 da = d3_sub(a0, s->point), db = d3_sub(b, s->point);
-        wa = d3_len(da), wb = d3_len(db);
-        double ang = wa > 0.0 && wb > 0.0 ? acos(fmax(-1.0, fmin(1.0, d3_dot(da, db) / (wa * wb)))) : 0.0;
-        len = ang * s->map->res;
+    const LightView *lv = &s->map->view;
+    Seg g = seg_make(s->map, a0, b, lightview_locate(lv, a0).face, lightview_locate(lv, b).face);
+    double wa = 1.0, wb = 1.0;
+    if (!g.fast || lv->face[g.face].perspective) {
+        bool clip = g.fast && g.c0.w > 0.0 && g.c0.w + g.dc.w > 0.0;
+        wa = clip ? g.c0.w : d3_len(d3_sub(a0, s->point));
+        wb = clip ? g.c0.w + g.dc.w : d3_len(d3_sub(b, s->point));
     }
-    int steps = (int)fmin(ceil(2.0 * len), 8.0 * s->map->res) + 1;
-    float prev = verdict(s->map, a0);
+    int steps = (int)fmin(ceil(2.0 * seg_texels(&g, s->point)), 8.0 * s->map->res) + 1;
+    float prev = seg_verdict(&g, 0.0);
     if (isnan(prev)) return false;
     *lit0 += u0 > 0.0 ? 1 : (int)prev; /* inside the ball it is lit */
     if (u0 > 0.0 && prev == 0.0f && !push_event(sc, (float)(za + u0 * (zb - za)), -1)) return *oom = true;
     double lam_prev = 0.0;
     for (int q = 1; q <= steps; q++) {
         double lam = (double)q / steps;
-        float v = verdict(s->map, d3_madd(a0, d3_sub(b, a0), ray_u(lam, wa, wb)));
+        float v = seg_verdict(&g, ray_u(lam, wa, wb));
         if (isnan(v)) return false;
         if (v != prev) { /* bisect [lam_prev, lam] for the change */
             double lo = lam_prev, hi = lam;
             for (int r = 0; r < PDM_REFINE; r++) {
                 double mid = 0.5 * (lo + hi);
-                float vm = verdict(s->map, d3_madd(a0, d3_sub(b, a0), ray_u(mid, wa, wb)));
+                float vm = seg_verdict(&g, ray_u(mid, wa, wb));
                 if (isnan(vm)) return false;
                 if (vm == prev) lo = mid;
                 else hi = mid;

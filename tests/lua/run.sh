@@ -282,6 +282,8 @@ run_repro() { # run_repro EXPERIMENT ARGS...: its output in $R/EXPERIMENT.log, i
         --warmup 0 --no-images --quiet --threads 1 # ~2 s
     run_repro course-fig1.8-layers --scenes one-layer.lua,overlap.lua,sphere-on-plane.lua --map-size 256 \
         --set camera.width=48 --set camera.height=36 --samples 16 --threads 1 # ~2 s
+    run_repro course-5.2.4-penumbra-deep-map --map-size 64 --set camera.width=48 --set camera.height=36 --samples 16 \
+        --threads 1 # ~1 s
 ) &
 lane=$!
 run_repro seed000-fig3 $TINYQ
@@ -303,7 +305,8 @@ for e in seed000-fig3 seed001-adaptive-area seed002-single-sample seed003-shadow
          course-fig2.2-bias course-fig2.3-midpoint course-fig4.3-pcf-umbra course-fig4.5-vsm-bleeding \
          course-fig4.7-csm-terms course-fig5.10-5.11-multiscale course-fig5.14-outer-penumbra fig3-7-aliasing-vs-z \
          fig3-10-12-partitions fig3-13-storage-factor course-fig2.4-2.10-shadow-volumes exact-soft-vs-rays \
-         soft-failures course-fig5.5-5.8-occluders course-ch7-backprojection-vs-pcss course-fig1.8-layers; do
+         soft-failures course-fig5.5-5.8-occluders course-ch7-backprojection-vs-pcss course-fig1.8-layers \
+         course-5.2.4-penumbra-deep-map; do
     expect "${e}_reproduces" 0 "paper against measured" "reproduction:" -- \
         sh -c 'cat "$1.log"; exit "$(cat "$1.rc" 2>/dev/null || echo 1)"' sh "$R/$e"
 done
@@ -341,6 +344,8 @@ figure course_fig5_5_gaps_leak "$R/course-fig5.5-5.8-occluders/reproduction.csv"
     item~"micropatch/none /" --hold
 figure course_fig5_8_microquad_misses_twigs "$R/course-fig5.5-5.8-occluders/reproduction.csv" measured 1 1000 \
     item~"twig: microquad" --hold
+figure course_5_2_4_build_linear_in_n "$R/course-5.2.4-penumbra-deep-map/reproduction.csv" measured 2 8 \
+    item~"build N = 16 / N = 4" --hold
 figure course_ch7_coarse_worse_than_pcss "$R/course-ch7-backprojection-vs-pcss/reproduction.csv" measured 1 100 \
     item~"sphere-on-plane: backprojection T = 2" --hold
 figure course_fig1_8_hidden_layer "$R/course-fig1.8-layers/reproduction.csv" measured 3 8 \
