@@ -55,6 +55,9 @@
 /* Bisections of a verdict change on the segment: its depth to 2^-12 of a
  * half-texel step of map k. */
 #define PDM_REFINE 12
+/* Texels a side of the tiles whose depth bounds let a march skip a span
+ * whose verdict cannot change (sample_events). */
+#define PDM_TILE 8
 #define PDM_MAX_VERTICES 1024
 /* A flat run this many times longer than the interval after the break it
  * meets is a knee (compress): it ends flat rather than tilt toward a drop. */
@@ -190,6 +193,8 @@ typedef struct SampleMap {
     const ShadowMap *map;
     dvec3 point;       /* the sample, world */
     double lit_within; /* points nearer the sample than this see it (the map's nearest stored depth) */
+    int tiles;         /* tiles a side of each face, PDM_TILE texels each */
+    float *tile_min, *tile_max; /* stored depth's bounds per tile (NaN in it: -inf, +inf), faces x tiles^2 */
 } SampleMap;
 
 /* The ray's parameter u in [0, 1] (a + u (b - a)) at screen parameter lam of
@@ -210,6 +215,39 @@ static double leave_ball(dvec3 a, dvec3 b, dvec3 c, double r)
     if (!(C < 0.0) || !(A > 0.0)) return 0.0;
     double u = (-B + sqrt(B * B - A * C)) / A; /* the far root: C < 0, so real */
     return u < 1.0 ? u : 1.0;
+}
+
+/* The stored metric of the point at u of a `fast` segment (the face's). */
+static double seg_ref(const Seg *g, double u)
+{
+    if (g->map->spec.depth == RASTER_DEPTH_LINEAR) return g->d0 + u * g->dd;
+    return (g->c0.z + u * g->dc.z) / (g->c0.w + u * g->dc.w);
+}
+
+/* How far (screen parameter lam, perspective-correct as ray_u) a march at
+ * lam with verdict v may jump: to where its image leaves the current tile,
+ * when the verdict cannot change before (the point's stored metric, monotone
+ * along the segment, stays below the tile's nearest depth: lit; or above its
+ * farthest, every texel a caster: shadowed); else lam itself. Screen
+ * coordinates are linear in lam on a face (sa, sb: the ends' (s, t)). */
+static double skip_to(const Seg *g, const SampleMap *s, double lam, double wa, double wb, const double sa[2],
+                      const double sb[2], float v)
+{
+    double at[2], exit = 1.0;
+    for (int k = 0; k < 2; k++) {
+        at[k] = sa[k] + lam * (sb[k] - sa[k]);
+        if (!(at[k] >= 0.0 && at[k] < g->map->res)) return lam;
+        double d = sb[k] - sa[k], edge = (floor(at[k] / PDM_TILE) + (d > 0.0)) * PDM_TILE;
+        if (d != 0.0) exit = fmin(exit, (edge - sa[k]) / d);
+    }
+    exit = lam + (exit - lam) * (1.0 - 1e-9); /* inside the tile */
+    if (!(exit > lam)) return lam;
+    int n = s->tiles;
+    size_t t = ((size_t)g->face * n + (size_t)(at[1] / PDM_TILE)) * n + (size_t)(at[0] / PDM_TILE);
+    double r0 = seg_ref(g, ray_u(lam, wa, wb)), r1 = seg_ref(g, ray_u(exit, wa, wb));
+    if (v == 1.0f && fmax(r0, r1) < s->tile_min[t]) return exit; /* fmax: r0, r1 finite on a face in front */
+    if (v == 0.0f && fmin(r0, r1) > s->tile_max[t]) return exit;
+    return lam;
 }
 
 /* Steps of the segment's image in texels: from the face's clip coordinates
@@ -247,8 +285,21 @@ static bool sample_events(const SampleMap *s, dvec3 a, dvec3 b, double za, doubl
     if (isnan(prev)) return false;
     *lit0 += u0 > 0.0 ? 1 : (int)prev; /* inside the ball it is lit */
     if (u0 > 0.0 && prev == 0.0f && !push_event(sc, (float)(za + u0 * (zb - za)), -1)) return *oom = true;
+    /* the ends' screen coordinates, for skip_to: a face in front of the eye at both */
+    bool tiled = g.fast && g.c0.w > 0.0 && g.c0.w + g.dc.w > 0.0;
+    double sa[2] = {0.0, 0.0}, sb[2] = {0.0, 0.0};
+    if (tiled) {
+        double w1 = g.c0.w + g.dc.w, half = 0.5 * s->map->res;
+        sa[0] = (g.c0.x / g.c0.w + 1.0) * half, sa[1] = (g.c0.y / g.c0.w + 1.0) * half;
+        sb[0] = ((g.c0.x + g.dc.x) / w1 + 1.0) * half, sb[1] = ((g.c0.y + g.dc.y) / w1 + 1.0) * half;
+    }
     double lam_prev = 0.0;
     for (int q = 1; q <= steps; q++) {
+        if (tiled) { /* jump the steps whose verdict cannot change */
+            int to = (int)floor(skip_to(&g, s, lam_prev, wa, wb, sa, sb, prev) * steps);
+            if (to > q) q = to, lam_prev = (double)to / steps;
+            if (q > steps) break;
+        }
         double lam = (double)q / steps;
         float v = seg_verdict(&g, ray_u(lam, wa, wb));
         if (isnan(v)) return false;
@@ -578,6 +629,31 @@ static double nearest_stored(const ShadowMap *m)
     return isfinite(best) ? best * (1.0 - 1e-6) : 0.0; /* the margin: locate's rounding */
 }
 
+/* The stored depth's bounds over each PDM_TILE^2 tile of each face (a tile
+ * holding a NaN gets [-inf, +inf]: never skipped); false out of memory. */
+static bool tile_bounds(SampleMap *s)
+{
+    const ShadowMap *m = s->map;
+    int n = (m->res + PDM_TILE - 1) / PDM_TILE;
+    size_t count = (size_t)m->num_faces * n * n;
+    s->tiles = n;
+    s->tile_min = malloc(count * sizeof *s->tile_min);
+    s->tile_max = malloc(count * sizeof *s->tile_max);
+    if (!s->tile_min || !s->tile_max) return false;
+    for (size_t k = 0; k < count; k++) s->tile_min[k] = INFINITY, s->tile_max[k] = -INFINITY;
+    for (int f = 0; f < m->num_faces; f++)
+        for (int j = 0; j < m->res; j++) {
+            const float *row = shadowmap_row(m, f, j, m->res);
+            for (int i = 0; i < m->res; i++) {
+                size_t k = ((size_t)f * n + j / PDM_TILE) * n + i / PDM_TILE;
+                float lo = isnan(row[i]) ? -INFINITY : row[i], hi = isnan(row[i]) ? INFINITY : row[i];
+                s->tile_min[k] = lo < s->tile_min[k] ? lo : s->tile_min[k];
+                s->tile_max[k] = hi > s->tile_max[k] ? hi : s->tile_max[k];
+            }
+        }
+    return true;
+}
+
 typedef struct PdmState {
     SmapBias bias;
     const ShadowMap *centre;
@@ -632,10 +708,13 @@ static bool pdm_prepare(const TechContext *ctx, void **state, Error *err)
     bool ok = deep_check(most_texels, a.max_vertices, spec.res, err) &&
               ls_sample_maps(ctx, &spec, a.n, (int)p[P_PATTERN], point, map, err) &&
               (a.centre = ls_point_map(ctx, &spec, ctx->light->position, err));
-    for (int k = 0; ok && k < a.n; k++)
-        sample[k] = (SampleMap){map[k], d3_from(point[k]), nearest_stored(map[k])};
+    for (int k = 0; ok && k < a.n; k++) {
+        sample[k] = (SampleMap){map[k], d3_from(point[k]), nearest_stored(map[k]), 0, NULL, NULL};
+        if (!tile_bounds(&sample[k])) ok = error_set(err, "out of memory");
+    }
     ok = ok && (st->deep = acquire_deep_map(ctx, &a, err));
     st->centre = a.centre;
+    for (int k = 0; k < a.n; k++) free(sample[k].tile_min), free(sample[k].tile_max);
     free(map), free(point), free(sample);
     if (!ok) {
         free(st);
