@@ -15,7 +15,9 @@
  * segment) enters another texel or passes that texel's stored depth. The
  * build marches each segment at most half a texel of map k at a time
  * (perspective-correct steps, so they are even in texels) and bisects each
- * change of verdict down to PDM_REFINE halvings [derived]. Unlike a deep
+ * change of verdict down to PDM_REFINE halvings [derived]; only the ray's
+ * part inside the scene's bounds is marched, and a span whose verdict a
+ * tile's depth bounds fix is jumped (skip_to). Unlike a deep
  * shadow map's transmittance (Lokovic & Veach 2000) V need not fall
  * monotonically: past a caster smaller than the light a sample's segment
  * clears the caster again and V rises [derived], so the functions are kept
@@ -26,12 +28,14 @@
  * segment growth (Deep shadow maps, SIGGRAPH 2000, §4.2, as St-Amour et al.
  * §4 use it): from a fixed origin, the interval of slopes that keeps the
  * segment within error of every step end is narrowed until it empties;
- * steps taller than 2 error become a jump (two vertices at one depth). So a
+ * steps taller than 2 error become a jump (two vertices at one depth);
+ * where a segment ends is chosen for the long runs receivers read (compress,
+ * end_value: not Lokovic & Veach's middle slope). So a
  * staircase of equal steps 1/N compresses to one segment when error >=
  * 1/(2N) [derived: a line through its mid-risers is within 1/(2N) of every
  * step], and error = 0 keeps every event. A texel needing more than
  * max_vertices is compressed again with the tolerance doubled until it fits
- * (counted: the resource log's note).
+ * (counted: the resource log's note), up to 1/2: then the constant 1/2.
  *
  * Lookup: the receiver's four nearest texels, weighted bilinearly (or its
  * texel alone: nearest, which converges to `light_sampling` as the texels
@@ -77,8 +81,9 @@ static const ParamDesc pdm_params[] = {
      "depth (Lokovic & Veach 2000); 0 keeps every event; a staircase of N steps becomes one segment from 1/(2N)",
      NULL},
     {"max_vertices", PARAM_INT, 32, 2, PDM_MAX_VERTICES, "vertices",
-     "vertex cap per texel: a function needing more is compressed again with the bound doubled until it fits "
-     "(counted); memory is at most faces x map_size^2 x (8 max_vertices + 5) bytes, refused above 2 GiB",
+     "vertex cap per texel: a function needing more is compressed again with the bound doubled until it fits, "
+     "up to 1/2 (then the constant 1/2; counted in the resource log); memory is at most faces x map_size^2 x "
+     "(8 max_vertices + 5) bytes, refused above 2 GiB",
      NULL},
     {"filter", PARAM_ENUM, FILTER_BILINEAR, 0, 1, "",
      "lookup: the receiver's texel's function (nearest), or the four nearest texels' functions, each at the "
