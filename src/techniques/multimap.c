@@ -195,7 +195,8 @@ static void ldi_mark_ray(Ldi *l, const ShadowMap *m, int face, double s, double 
 {
     const RasterView *rv = &m->view.face[face].raster;
     dvec3 a, b;
-    if (!mm_texel_point(&m->view, face, s, t, rv->depth_near, &a) || !mm_texel_point(&m->view, face, s, t, rv->depth_far, &b))
+    if (!mm_texel_point(&m->view, face, s, t, rv->depth_near, &a) ||
+        !mm_texel_point(&m->view, face, s, t, rv->depth_far, &b))
         return;
     MapCoord ca = lightview_locate(l->view, a), cb = lightview_locate(l->view, b);
     double len = ca.face == cb.face ? hypot(cb.s - ca.s, cb.t - ca.t) : 2.0 * l->view->res;

@@ -133,16 +133,44 @@ static bool push_event(Scratch *s, float z, int delta)
     return true;
 }
 
+/* The stored depth's change across one texel at (i, j) of a face: per
+ * axis the smaller of the two one-sided differences (on a plane both are
+ * its slope; at a silhouette one side jumps, the other does not), the larger
+ * of the axes; 0 where neither side is finite [derived]. */
+static double texel_slope(const ShadowMap *m, int face, int i, int j, float z)
+{
+    double slope = 0.0;
+    for (int axis = 0; axis < 2; axis++) {
+        float lo = axis ? shadowmap_texel(m, face, i, j - 1) : shadowmap_texel(m, face, i - 1, j);
+        float hi = axis ? shadowmap_texel(m, face, i, j + 1) : shadowmap_texel(m, face, i + 1, j);
+        double d = fmin(fabs((double)z - lo), fabs((double)hi - z)); /* fmin: one NaN side leaves the other */
+        if (isfinite(d)) slope = d > slope ? d : slope;
+    }
+    return slope;
+}
+
 /* Sample k's depth test (course §2.1, in the map's stored metric) of the
- * located point mc: 1 lit, 0 shadowed, NaN unknown; lit off the map. */
-static float verdict_at(const ShadowMap *m, const MapCoord *mc)
+ * located point mc: 1 lit, 0 shadowed, NaN unknown; lit off the map. A
+ * point behind the stored depth by less than slope_bias times the map's own
+ * depth change across the texel (at most slope_max texel widths) is lit: the slope-scaled bias of course
+ * §2.1.2 in each sample's map, as light_sampling's tests have it (the
+ * receiver's, applied at lookup, is the centre face's: on sphere-on-plane's
+ * ground the centre's -y face has slope 0 where samples' -z faces graze). */
+static float verdict_at(const ShadowMap *m, const MapCoord *mc, const SmapBias *bias)
 {
     if (!mc->inside) return 1.0f;
     int i = (int)mc->s, j = (int)mc->t;
     i = i < m->res ? i : m->res - 1; /* s < res, but rounding may reach it */
     j = j < m->res ? j : m->res - 1;
     double ref = m->spec.depth == RASTER_DEPTH_NDC ? mc->z_ndc : mc->depth_linear;
-    return smap_test(ref, shadowmap_texel(m, mc->face, i, j));
+    float z = shadowmap_texel(m, mc->face, i, j);
+    float v = smap_test(ref, z);
+    if (v == 0.0f && bias->slope > 0.0) { /* clamped at slope_max texel widths, as smap.c's */
+        double most = bias->slope_max_texels * lightview_texel_world(&m->view, mc);
+        if (m->spec.depth == RASTER_DEPTH_NDC) most *= lightview_ndc_per_world(&m->view, mc);
+        v = smap_test(ref, z + fmin(bias->slope * texel_slope(m, mc->face, i, j, z), most));
+    }
+    return v;
 }
 
 /* A segment a + u (b - a) of world space seen through one face of sample
@@ -152,6 +180,7 @@ static float verdict_at(const ShadowMap *m, const MapCoord *mc)
  * segment spans faces (located per point). */
 typedef struct Seg {
     const ShadowMap *map;
+    const SmapBias *bias; /* the depth tests' slope bias (verdict_at) */
     dvec3 a, ab;
     bool fast;
     int face;
@@ -159,9 +188,9 @@ typedef struct Seg {
     double d0, dd; /* linear depth likewise */
 } Seg;
 
-static Seg seg_make(const ShadowMap *m, dvec3 a, dvec3 b, int face_a, int face_b)
+static Seg seg_make(const ShadowMap *m, const SmapBias *bias, dvec3 a, dvec3 b, int face_a, int face_b)
 {
-    Seg g = {.map = m, .a = a, .ab = d3_sub(b, a), .fast = face_a == face_b, .face = face_a};
+    Seg g = {.map = m, .bias = bias, .a = a, .ab = d3_sub(b, a), .fast = face_a == face_b, .face = face_a};
     const MapFace *f = &m->view.face[face_a];
     const double *row = f->raster.depth_row;
     dvec4 ca = m4_apply(&f->raster.clip_from_world, a), cb = m4_apply(&f->raster.clip_from_world, b);
@@ -179,7 +208,7 @@ static float seg_verdict(const Seg *g, double u)
     const ShadowMap *m = g->map;
     if (!g->fast) {
         MapCoord mc = lightview_locate(&m->view, d3_madd(g->a, g->ab, u));
-        return verdict_at(m, &mc);
+        return verdict_at(m, &mc, g->bias);
     }
     double w = g->c0.w + u * g->dc.w;
     MapCoord mc = {.face = g->face, .depth_linear = g->d0 + u * g->dd};
@@ -190,7 +219,7 @@ static float seg_verdict(const Seg *g, double u)
         mc.inside = mc.s >= 0.0 && mc.s < m->res && mc.t >= 0.0 && mc.t < m->res && mc.z_ndc >= 0.0 &&
                     mc.z_ndc <= 1.0;
     }
-    return verdict_at(m, &mc);
+    return verdict_at(m, &mc, g->bias);
 }
 
 /* One sample's map and what bounds its march. */
@@ -272,13 +301,13 @@ static double seg_texels(const Seg *g, dvec3 point)
  * centre's axis); false when a verdict is NaN (the texel is unknown). The
  * steps are perspective-correct on a face (depths wa, wb: even in texels),
  * else along the chord of directions from the sample. */
-static bool sample_events(const SampleMap *s, dvec3 a, dvec3 b, double za, double zb, Scratch *sc, int *lit0,
-                          bool *oom)
+static bool sample_events(const SampleMap *s, const SmapBias *bias, dvec3 a, dvec3 b, double za, double zb,
+                          Scratch *sc, int *lit0, bool *oom)
 {
     double u0 = leave_ball(a, b, s->point, s->lit_within);
     dvec3 a0 = d3_madd(a, d3_sub(b, a), u0);
     const LightView *lv = &s->map->view;
-    Seg g = seg_make(s->map, a0, b, lightview_locate(lv, a0).face, lightview_locate(lv, b).face);
+    Seg g = seg_make(s->map, bias, a0, b, lightview_locate(lv, a0).face, lightview_locate(lv, b).face);
     double wa = 1.0, wb = 1.0;
     if (!g.fast || lv->face[g.face].perspective) {
         bool clip = g.fast && g.c0.w > 0.0 && g.c0.w + g.dc.w > 0.0;
@@ -441,6 +470,7 @@ typedef struct DeepArgs {
     const SampleMap *sample;
     int n, max_vertices;
     double error;
+    SmapBias bias; /* its slope and slope_max act in each sample's depth tests */
 } DeepArgs;
 
 /* The part [*u0, *u1] of the segment a + u (b - a), u in [0, 1], inside the
@@ -486,7 +516,7 @@ static int texel_function(const DeepArgs *d, int face, int i, int j, Scratch *sc
     int lit0 = 0;
     bool oom = false;
     for (int k = 0; k < d->n; k++) {
-        if (!sample_events(&d->sample[k], ca, cb, za, zb, sc, &lit0, &oom)) return 0;
+        if (!sample_events(&d->sample[k], &d->bias, ca, cb, za, zb, sc, &lit0, &oom)) return 0;
         if (oom) return -1;
     }
     int m = step_function(sc, lit0, d->n, (float)za, (float)zb);
@@ -674,6 +704,8 @@ static const DeepMap *acquire_deep_map(const TechContext *ctx, DeepArgs *a, Erro
     hash_u64(&h, a->centre->key);
     for (int k = 0; k < a->n; k++) hash_u64(&h, a->sample[k].map->key);
     hash_f64(&h, a->error);
+    hash_f64(&h, a->bias.slope);
+    hash_f64(&h, a->bias.slope_max_texels);
     hash_f64(&h, a->max_vertices);
     uint64_t key = hash_final(&h);
     char desc[160];
@@ -708,8 +740,12 @@ static bool pdm_prepare(const TechContext *ctx, void **state, Error *err)
     dvec3 margin = d3_from(v3(1.0f, 1.0f, 1.0f));
     margin = d3_scale(margin, 1e-3 * scene_extent(ctx->scene));
     DeepArgs a = {.box_min = d3_sub(d3_from(ctx->scene->bounds_min), margin),
-                  .box_max = d3_add(d3_from(ctx->scene->bounds_max), margin), .sample = sample, .n = (int)p[P_SAMPLES], .max_vertices = (int)p[P_MAX_VERTICES],
-                  .error = p[P_ERROR]};
+                  .box_max = d3_add(d3_from(ctx->scene->bounds_max), margin),
+                  .sample = sample,
+                  .n = (int)p[P_SAMPLES],
+                  .max_vertices = (int)p[P_MAX_VERTICES],
+                  .error = p[P_ERROR],
+                  .bias = st->bias};
     bool ok = deep_check(most_texels, a.max_vertices, spec.res, err) &&
               ls_sample_maps(ctx, &spec, a.n, (int)p[P_PATTERN], point, map, err) &&
               (a.centre = ls_point_map(ctx, &spec, ctx->light->position, err));
