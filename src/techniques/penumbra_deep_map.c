@@ -44,6 +44,9 @@
  * when receiver_plane is on (course §4.1.2 box: otherwise a texel's ray
  * meets the receiver up to a texel's slope away and the functions drop to
  * 0 there), less the shared bias, with the shared set-up (smap_receivers).
+ * At the build each sample's depth test takes the slope-scaled bias of its
+ * own map (verdict_at), as light_sampling's tests do: the centre face's
+ * bias cannot stand in for theirs.
  * Like `layered_attenuation`, V counts all N samples, also those below the
  * receiver's tangent plane (the function is the ray's, not the surface's):
  * it agrees with `light_sampling` off the terminator. The course's cost
