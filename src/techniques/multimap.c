@@ -168,10 +168,9 @@ static bool ldi_texel(const Ldi *l, dvec3 x, size_t *t, double *z)
     return true;
 }
 
-/* The world point at linear depth z on the ray through texel coordinates
- * (s, t) of a face: the stored point of the map (lightview.h: depth is the
- * face's depth_row, affine in world space, or a paraboloid's radius). */
-static bool texel_point(const LightView *v, int face, double s, double t, double z, dvec3 *x)
+/* The stored point of a map at depth z (lightview.h: depth is the face's
+ * depth_row, affine in world space, or a paraboloid's radius). */
+bool mm_texel_point(const LightView *v, int face, double s, double t, double z, dvec3 *x)
 {
     const MapFace *f = &v->face[face];
     dvec3 org, dir;
@@ -196,7 +195,8 @@ static void ldi_mark_ray(Ldi *l, const ShadowMap *m, int face, double s, double 
 {
     const RasterView *rv = &m->view.face[face].raster;
     dvec3 a, b;
-    if (!texel_point(&m->view, face, s, t, rv->depth_near, &a) || !texel_point(&m->view, face, s, t, rv->depth_far, &b))
+    if (!mm_texel_point(&m->view, face, s, t, rv->depth_near, &a) ||
+        !mm_texel_point(&m->view, face, s, t, rv->depth_far, &b))
         return;
     MapCoord ca = lightview_locate(l->view, a), cb = lightview_locate(l->view, b);
     double len = ca.face == cb.face ? hypot(cb.s - ca.s, cb.t - ca.t) : 2.0 * l->view->res;
@@ -231,7 +231,7 @@ static int texel_points(const ShadowMap *m, int face, int i, int j, float stored
         double z = smap_linear_depth(m, face, stored);
         for (int b = 0; b < LA_WARP_SUB; b++)
             for (int a = 0; a < LA_WARP_SUB; a++)
-                k += texel_point(&m->view, face, i + (a + 0.5) / LA_WARP_SUB, j + (b + 0.5) / LA_WARP_SUB, z, &x[k]);
+                k += mm_texel_point(&m->view, face, i + (a + 0.5) / LA_WARP_SUB, j + (b + 0.5) / LA_WARP_SUB, z, &x[k]);
         return k;
     }
     dvec4 c = clip_point(m, f, i, j, stored), ds = clip_point(m, f, i + 1, j, stored),

@@ -35,4 +35,33 @@ const ShadowMap *ls_point_map(const TechContext *ctx, const ShadowMapSpec *spec,
 bool ls_sample_maps(const TechContext *ctx, const ShadowMapSpec *spec, int n, int pattern,
                     vec3 *point, const ShadowMap **map, Error *err);
 
+/* The world point at linear depth z (world units along the face's axis, or
+ * a paraboloid's radius) on the ray through texel coordinates (s, t) of a
+ * face; false where the ray runs parallel to the face's depth planes. */
+bool mm_texel_point(const LightView *v, int face, double s, double t, double z, dvec3 *x);
+
+/* The penumbra deep shadow map (penumbra_deep_map.c), declared here so the
+ * tests can read the built resource (kind "penumbra_deep_map"): per texel of
+ * the centre's map (faces x res^2, texel (face, i, j) at (face res + j) res
+ * + i), a piecewise-linear visibility of linear depth along the texel's
+ * centre ray, vertices sorted by depth; two vertices at one depth are a
+ * step (the function is right-continuous there). */
+typedef struct DeepVertex {
+    float z; /* linear depth along the centre face's axis, world units */
+    float v; /* visibility, [0, 1] */
+} DeepVertex;
+
+typedef struct DeepMap {
+    int n;              /* light samples */
+    double error;       /* the compression's bound (max |deviation| in visibility) */
+    int max_vertices;   /* per texel */
+    int res, num_faces;
+    size_t texels;
+    uint32_t *first;    /* [texels + 1]: texel t's vertices are vertex[first[t] .. first[t + 1]) */
+    DeepVertex *vertex;
+    uint8_t *unknown;   /* a sample's map read NaN on the texel's ray: its visibility is unknown */
+    long capped;        /* texels that needed more than max_vertices at `error` (compressed looser) */
+    long events;        /* visibility events found (steps of the uncompressed functions) */
+} DeepMap;
+
 #endif

@@ -35,6 +35,7 @@ extern const Technique tech_mssm;
 extern const Technique tech_ysm;
 extern const Technique tech_light_sampling;
 extern const Technique tech_layered_attenuation;
+extern const Technique tech_penumbra_deep_map;
 extern const Technique tech_occlusion_textures;
 extern const Technique tech_smrt;
 extern const Technique tech_shadow_volume;
@@ -75,6 +76,7 @@ static const Technique *const registry[] = {
     &tech_ysm,
     &tech_light_sampling,
     &tech_layered_attenuation,
+    &tech_penumbra_deep_map,
     &tech_occlusion_textures,
     &tech_smrt,
     &tech_shadow_volume,
