@@ -8,7 +8,9 @@
  *     evaluation, lab.h) and evaluation time against its main parameter
  *     (the one it declares in the registry), against map_size where it has one,
  *     against triangle count (the scene's objects[2].segments) and against
- *     image size (camera.width x camera.height at 4:3);
+ *     image size (camera.width x camera.height at 4:3); --quick: one of
+ *     these four axes a technique, rotating with its registry index
+ *     (growth_axis), maps up to 1024^2;
  *   constant: techniques with a summed-area-table prefilter (a `prefilter`
  *     choice named sat) at K = its minimum and maximum: frame time at the
  *     largest K within 1.2x of the smallest (the papers' claim);
@@ -358,6 +360,30 @@ static bool growth_scene(const Options *o, Subject *sj, const char *axis, const 
     return true;
 }
 
+/* The growth axes, in the order --quick rotates through them. */
+enum { AXIS_MAIN, AXIS_MAP, AXIS_TRIANGLES, AXIS_IMAGE, NUM_AXES };
+
+/* Position of t in the registry (tech_at). */
+static int registry_index(const Technique *t)
+{
+    for (int i = 0; i < tech_count(); i++)
+        if (tech_at(i) == t) return i;
+    return 0;
+}
+
+/* Does growth run axis a for sj? Every axis in a full run; with --quick one
+ * axis a technique, its registry index modulo the axes (the next one that
+ * applies where that one does not: no main parameter or no map), so every
+ * technique is measured and every axis by a quarter of them. */
+static bool growth_axis(const Options *o, const Subject *sj, int a)
+{
+    if (!o->quick) return true;
+    bool applies[NUM_AXES] = {main_param(sj->t) >= 0, tech_param_index(sj->t, "map_size") >= 0, true, true};
+    int k = registry_index(sj->t) % NUM_AXES;
+    while (!applies[k]) k = (k + 1) % NUM_AXES;
+    return k == a;
+}
+
 static bool growth(const Options *o, Subject *sj, Error *err)
 {
     static const int maps[] = {256, 512, 1024, 2048, 4096}, segs[] = {24, 96, 256, 512, 1024};
@@ -369,18 +395,22 @@ static bool growth(const Options *o, Subject *sj, Error *err)
     announce(o, sj, "growth");
     bool ok = true;
     int mp = main_param(sj->t), ms = tech_param_index(sj->t, "map_size");
-    if (mp >= 0) {
+    if (mp >= 0 && growth_axis(o, sj, AXIS_MAIN)) {
         double v[MAX_POINTS];
         ok = growth_param(o, lab, sj, mp, v, param_values(&sj->t->params[mp], v), err);
     }
-    if (ok && ms >= 0) {
+    if (ok && ms >= 0 && growth_axis(o, sj, AXIS_MAP)) {
         double v[5];
-        for (int i = 0; i < nq + 1 && i < 5; i++) v[i] = maps[i];
-        ok = growth_param(o, lab, sj, ms, v, nq + 1 < 5 ? nq + 1 : 5, err);
+        int nmaps = o->quick ? 3 : 5; /* --quick: up to 1024^2 */
+        for (int i = 0; i < nmaps; i++) v[i] = maps[i];
+        ok = growth_param(o, lab, sj, ms, v, nmaps, err);
     }
     lab_close(lab);
-    ok = ok && growth_scene(o, sj, "triangles", "objects[2].segments=%d", segs, nq, err);
-    return ok && growth_scene(o, sj, "image_width", "camera.width=%d", widths, o->quick ? 3 : 4, err);
+    if (ok && growth_axis(o, sj, AXIS_TRIANGLES))
+        ok = growth_scene(o, sj, "triangles", "objects[2].segments=%d", segs, nq, err);
+    if (ok && growth_axis(o, sj, AXIS_IMAGE))
+        ok = growth_scene(o, sj, "image_width", "camera.width=%d", widths, o->quick ? 3 : 4, err);
+    return ok;
 }
 
 /* ---- constant time in K ------------------------------------------------------ */
