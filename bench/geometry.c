@@ -14,11 +14,14 @@
  *     computed, not cached: reference_compute), frame time (its mapping is
  *     its prepare) against the reference's time, alternating per round, on
  *     sphere-on-plane and the bunny (320 x 240; --quick 160 x 120); and its
- *     frame time against the ball's triangles on sphere-on-plane
- *     (segments 16 ... 128): ns per caster triangle per lit candidate, the
- *     pairs the influence regions are a subset of (view_sample_mapping.c
- *     counts no influence-region work: the ratio to the smallest size says
- *     how far below that bound its culling keeps the cost).
+ *     frame time per influence pair (work.influence: the (caster triangle,
+ *     view sample) pairs map_triangle maps, the sum of the triangles'
+ *     influence regions) against the ball's triangles on sphere-on-plane
+ *     (segments 16 ... 128: 290 ... 16,642 triangles), then on the bunny;
+ *     each row's ns per pair over the first's (near 1: the cost is linear in
+ *     the sum of the influence regions), the pairs' share of triangles x
+ *     lit candidates (the bound the regions are a subset of), and the ns
+ *     per pair added since the first row (the slope).
  * Rows: DIR/silhouette.csv, DIR/volumes.csv, DIR/vsm_reference.csv, DIR/vsm_triangles.csv.
  * Usage: geometry [--silhouette] [--volumes] [--vsm] [--quick] [--threads N] [--repeat R] [-o DIR] [SCENE...] */
 #include <math.h>
@@ -35,8 +38,8 @@
                    BENCH_TAIL_HEADER "\n"
 #define VOL_HEADER "scene,triangles,versus,map_size,shadow_volume_ms,other_ms,ratio," BENCH_TAIL_HEADER "\n"
 #define VSM_REF_HEADER "scene,triangles,width,height,samples,vsm_ms,reference_ms,ratio," BENCH_TAIL_HEADER "\n"
-#define VSM_TRI_HEADER "segments,triangles,lit_candidates,frame_ms,ns_per_triangle_sample," \
-                       "ns_per_triangle_sample_over_smallest," BENCH_TAIL_HEADER "\n"
+#define VSM_TRI_HEADER "scene,segments,triangles,lit_candidates,influence_pairs,pairs_over_triangles_samples," \
+                       "frame_ms,ns_per_pair,ns_per_pair_over_smallest,ns_per_added_pair," BENCH_TAIL_HEADER "\n"
 
 typedef struct Options {
     bool silhouette, volumes, vsm, quick;
@@ -246,51 +249,90 @@ static bool vsm_versus_reference(const BenchCommon *c, const Options *o, const c
     return ok;
 }
 
-/* Frame time against the ball's triangles, per (caster triangle, lit candidate) pair. */
+/* One view_sample_mapping frame size: the median frame time over the rounds
+ * and one frame's influence pairs (work.influence, counted in map_triangle:
+ * the sum of the caster triangles' influence regions in view samples). */
+typedef struct VsmFrame {
+    long triangles, lit;
+    uint64_t pairs;
+    double frame_s;
+} VsmFrame;
+
+static bool vsm_frame(const BenchCommon *c, const char *scene, const char *const *overrides, int num_overrides,
+                      VsmFrame *out, Error *err)
+{
+    const Technique *t = tech_find("view_sample_mapping", err);
+    Lab *lab = t ? lab_open(scene, overrides, num_overrides, err) : NULL;
+    if (!lab) return false;
+    double params[TECH_MAX_PARAMS], times[64];
+    tech_params_default(t, params);
+    RenderRequest req = {.tech = t, .params = params, .light_index = 0, .repeat = 1};
+    int rounds = c->repeat > 64 ? 64 : c->repeat;
+    bool ok = true;
+    for (int r = 0; ok && r < rounds; r++) {
+        RenderResult res;
+        ok = lab_render(lab, &req, &res, err);
+        if (!ok) break;
+        times[r] = res.frame_s;
+        out->lit = res.lit_candidates;
+        out->pairs = res.frame_work.influence; /* the mapping is the prepare: the frame's work */
+        render_result_free(&res);
+    }
+    out->triangles = ok ? scene_triangles(lab_scene(lab)) : 0;
+    lab_close(lab);
+    if (ok) out->frame_s = bench_median(times, rounds);
+    return ok;
+}
+
+/* One row of vsm_triangles.csv: ns per influence pair, its ratio to the
+ * first row's (`first`, set by that row), the pairs' share of the triangles
+ * x lit candidates bound, and the ns per pair added since the first row
+ * ((frame - first frame) / (pairs - first pairs): the slope, free of the
+ * per-view-sample cost of drawing and binning its light samples). */
+static bool vsm_influence_row(const BenchCommon *c, const char *scene, int segments, const VsmFrame *f,
+                              VsmFrame *first, double *smallest, const char *path, Error *err)
+{
+    double bound = (double)f->triangles * (double)f->lit;
+    double ns = f->pairs > 0 ? f->frame_s * 1e9 / (double)f->pairs : NAN; /* NaN: no pair mapped */
+    double share = bound > 0.0 ? (double)f->pairs / bound : NAN;          /* NaN: nothing lit */
+    if (*smallest == 0.0) { /* the first row */
+        *smallest = ns;
+        *first = *f;
+    }
+    double added = (double)f->pairs - (double)first->pairs; /* 0 on the first row: NaN */
+    double ns_added = added != 0.0 ? (f->frame_s - first->frame_s) * 1e9 / added : NAN;
+    char name[300], row[1024], tail[512];
+    bench_csv_field(name, sizeof name, scene);
+    bench_tail(tail, sizeof tail, c->threads);
+    snprintf(row, sizeof row, "%s,%d,%ld,%ld,%llu,%.5f,%.3f,%.3f,%.3f,%.3f,%s\n", name, segments, f->triangles,
+             f->lit, (unsigned long long)f->pairs, share, f->frame_s * 1e3, ns, ns / *smallest, ns_added, tail);
+    printf("vsm: %s %4d segments, %7ld triangles, %6ld lit samples: %11llu influence pairs (%.5f of triangles x "
+           "samples), frame %9.3f ms, %.3f ns per pair (x%.3f the smallest), %.3f ns per added pair\n", scene,
+           segments, f->triangles, f->lit, (unsigned long long)f->pairs, share, f->frame_s * 1e3, ns, ns / *smallest,
+           ns_added);
+    return bench_csv_append(path, VSM_TRI_HEADER, row, err);
+}
+
+/* Frame time per influence pair against the ball's triangles on
+ * sphere-on-plane, then on the bunny (segments 0: its mesh as loaded). */
 static bool vsm_triangles(const BenchCommon *c, const Options *o, Error *err)
 {
     static const int segments[] = {16, 32, 64, 128};
     char path[4096];
     snprintf(path, sizeof path, "%s/vsm_triangles.csv", c->dir);
     if (!bench_csv_reset(path, VSM_TRI_HEADER, err)) return false;
-    const Technique *t = tech_find("view_sample_mapping", err);
-    if (!t) return false;
-    double params[TECH_MAX_PARAMS], smallest = 0.0;
-    tech_params_default(t, params);
+    double smallest = 0.0;
+    VsmFrame f, first = {0};
     for (size_t k = 0; k < sizeof segments / sizeof segments[0]; k++) {
         char seg[64];
         snprintf(seg, sizeof seg, "objects[2].segments=%d", segments[k]);
         const char *ov[] = {seg, view_size(o)[0], view_size(o)[1]};
-        Lab *lab = lab_open("scenes/sphere-on-plane.lua", ov, 3, err);
-        if (!lab) return false;
-        RenderRequest req = {.tech = t, .params = params, .light_index = 0, .repeat = 1};
-        double times[64];
-        long lit = 0;
-        int rounds = c->repeat > 64 ? 64 : c->repeat;
-        bool ok = true;
-        for (int r = 0; ok && r < rounds; r++) {
-            RenderResult res;
-            ok = lab_render(lab, &req, &res, err);
-            if (!ok) break;
-            times[r] = res.frame_s;
-            lit = res.lit_candidates;
-            render_result_free(&res);
-        }
-        long tris = ok ? scene_triangles(lab_scene(lab)) : 0;
-        lab_close(lab);
-        if (!ok) return false;
-        double f = bench_median(times, rounds);
-        double pairs = (double)tris * (double)lit, ns = pairs > 0.0 ? f * 1e9 / pairs : NAN; /* NaN: nothing lit */
-        if (k == 0) smallest = ns;
-        char row[512], tail[512];
-        bench_tail(tail, sizeof tail, c->threads);
-        snprintf(row, sizeof row, "%d,%ld,%ld,%.3f,%.4f,%.3f,%s\n", segments[k], tris, lit, f * 1e3, ns, ns / smallest,
-                 tail);
-        printf("vsm: %4d segments, %7ld triangles, %6ld lit samples: frame %9.3f ms, %.4f ns per triangle x sample "
-               "(x%.3f the smallest)\n", segments[k], tris, lit, f * 1e3, ns, ns / smallest);
-        if (!bench_csv_append(path, VSM_TRI_HEADER, row, err)) return false;
+        if (!vsm_frame(c, "scenes/sphere-on-plane.lua", ov, 3, &f, err) ||
+            !vsm_influence_row(c, "scenes/sphere-on-plane.lua", segments[k], &f, &first, &smallest, path, err))
+            return false;
     }
-    return true;
+    return vsm_frame(c, "scenes/bunny.lua", view_size(o), 2, &f, err) &&
+           vsm_influence_row(c, "scenes/bunny.lua", 0, &f, &first, &smallest, path, err);
 }
 
 static bool bench_vsm(const BenchCommon *c, const Options *o, Error *err)

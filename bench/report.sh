@@ -488,7 +488,7 @@ trap 'rm -f "$cmp" "$gone" "$sum" "$md.tmp$$"' EXIT
     echo "per (caster triangle, lit candidate) pair against the ball's triangles:"
     echo
     table vsm_reference.csv scene triangles width height samples vsm_ms reference_ms ratio threads load_1min commit
-    table vsm_triangles.csv segments triangles lit_candidates frame_ms ns_per_triangle_sample ns_per_triangle_sample_over_smallest threads load_1min
+    table vsm_triangles.csv scene segments triangles lit_candidates influence_pairs pairs_over_triangles_samples frame_ms ns_per_pair ns_per_pair_over_smallest ns_per_added_pair threads load_1min
     echo "## 9. Cost against one axis (issue 15) and error against time at pcss's penumbra RMSE (issue 16)"
     echo
     echo "Per lit candidate per unit of the axis, over the first value's (linear: near 1); ratios are medians of per-round ratios:"

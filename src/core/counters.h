@@ -25,6 +25,9 @@ typedef struct WorkCounters {
                              * not counted: a lower bound of a GPU's fragment count under overdraw) */
     uint64_t edges;         /* possible silhouette edges tested against a view sample's cone
                              * (exact_soft.c's exact_for_silhouette: each edge sphere's cone test) */
+    uint64_t influence;     /* (caster triangle, view sample) pairs view_sample_mapping maps: the sum of the
+                             * triangles' influence regions in view samples (map_triangle's calls, both
+                             * mask paths; a sample whose light samples are all hidden takes no more) */
 } WorkCounters;
 
 /* This thread's block; register-free to write (work_snapshot finds it).
@@ -58,6 +61,9 @@ static inline void work_raster(uint64_t triangles, uint64_t fragments)
 
 /* n silhouette edges tested against a view sample's cone. */
 static inline void work_edges(uint64_t n) { work_thread.c.edges += n; }
+
+/* n (triangle, view sample) pairs of an influence region mapped. */
+static inline void work_influence(uint64_t n) { work_thread.c.influence += n; }
 
 /* The sum over every thread that ever counted (threads that have exited
  * included). Call it from serial code, outside parallel regions: it runs one

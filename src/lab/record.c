@@ -204,6 +204,7 @@ static void write_counters(JsonWriter *w, const WorkCounters *c)
     json_int(w, "triangles", (long long)c->triangles);
     json_int(w, "fragments", (long long)c->fragments);
     json_int(w, "edges", (long long)c->edges);
+    json_int(w, "influence", (long long)c->influence);
 }
 
 /* Machine-independent work (core/counters.h): one evaluation's, the

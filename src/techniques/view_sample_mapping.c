@@ -540,6 +540,7 @@ static bool misses_samples(const LightPoints *lp, P2 lo, P2 hi)
  * the light's centre and plane axes (the stored table's; light_plane_axes). */
 static void map_triangle(Mapped *m, const vec3 *tri, bool front_only, const dvec3 axes[3])
 {
+    work_influence(1); /* one pair of the triangle's influence region, on either mask path */
     dvec3 poly[4];
     int facing, np = exact_clip(&m->lp.f, tri, poly, &facing, NULL);
     if (np < 3 || facing == 0) return; /* nothing in front, or edge-on: it hides no sample */

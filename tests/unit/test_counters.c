@@ -152,6 +152,79 @@ TEST(test_counters_quad_depth_map_writes_its_texels)
     CHECK(w.triangles == 2 && w.fragments == 32 * 24);
 }
 
+/* view_sample_mapping's influence pairs (work.influence) against a hand
+ * count: a 1 x 1 quad (two triangles, receiver = false) at height 2 over a
+ * ground plane under a disk light of radius 3 at height 8 facing down, seen
+ * from the side below the quad. The disk seen from the ground (atan 3/8 =
+ * 0.36 rad) is wider than the quad (atan 0.25 = 0.24 rad), so no triangle
+ * hides all of a view sample's light samples and no sample stops taking
+ * triangles: each sample in the quad's influence region takes both of its
+ * triangles, two pairs. The ground's own triangles pass its ball tests but
+ * their plane separates it from the light (exact_triangle_reaches): none of
+ * their pairs is counted. The region is the samples whose cone toward their
+ * kept light samples (about the ray to the light's centre) meets the quad's
+ * bounding ball (bound_corners: the box's centre (0, 2, 0), its half-diagonal
+ * sqrt(2) / 2). So the count is even, and half of it lies between the
+ * samples whose ray to the light's centre passes through that ball (the
+ * cone's axis) and those whose cone toward the light's bounding sphere
+ * (half-angle asin(R / |L - p|), which holds the disk) meets it, 1e-3 rad of
+ * slack; the latter fewer than the lit candidates (a region, not every
+ * pair). The stored-table path (masks=hough sample_set=shared) counts the
+ * same way. About 0.5 s. */
+static const char *const quad_scene =
+    "return { name = 'quad', camera = { position = {0, 1, 4}, target = {0, 0, 0}, up = {0, 1, 0},\n"
+    "  fov = 50, width = 48, height = 36 },\n"
+    "  lights = { { type = 'disk', position = {0, 8, 0}, direction = {0, -1, 0}, radius = 3, intensity = 10 } },\n"
+    "  objects = { { name = 'ground', shape = 'plane', size = {20, 20} },\n"
+    "    { name = 'quad', shape = 'plane', size = {1, 1}, translate = {0, 2, 0}, receiver = false } } }\n";
+
+/* Lit candidates whose ray to the light's centre meets the quad's ball
+ * (inner) and whose cone toward the whole light does (outer), by hand
+ * (world space; the angle between the centre ray and the ball's centre
+ * against the ball's angular radius asin(r / |w|), plus the light's). */
+static void quad_influence_bounds(Lab *lab, long *inner, long *outer, long *lit)
+{
+    Error err;
+    const uint8_t *cls = res_classes(lab_resources(lab), lab_scene(lab), 0, &err);
+    const ViewSamples *vs = res_view_samples(lab_resources(lab), lab_scene(lab), &err);
+    const dvec3 light = d3(0, 8, 0), ball = d3(0, 2, 0);
+    const double light_r = 3.0, ball_r = sqrt(0.5), slack = 1e-3;
+    *inner = *outer = *lit = 0;
+    for (int s = 0; cls && vs && s < vs->count; s++) {
+        if (cls[s] != SAMPLE_LIT_CANDIDATE) continue;
+        dvec3 p = d3_from(vs->p_world[s]), a = d3_sub(light, p), w = d3_sub(ball, p);
+        double angle = acos(d3_dot(a, w) / (d3_len(a) * d3_len(w))), ball_angle = asin(ball_r / d3_len(w));
+        *lit += 1;
+        *inner += angle <= ball_angle - slack;
+        *outer += angle <= ball_angle + asin(light_r / d3_len(a)) + slack;
+    }
+}
+
+TEST(test_counters_vsm_influence_is_the_quads_footprint)
+{
+    Lab *lab = fixture_lab("quad.lua", quad_scene);
+    CHECK(lab);
+    long inner, outer, lit;
+    quad_influence_bounds(lab, &inner, &outer, &lit);
+    printf("    quad: %ld lit candidates, %ld with the light's centre ray through the quad's ball, %ld with its cone "
+           "reaching it\n", lit, inner,
+           outer);
+    CHECK(inner > 0 && outer < lit); /* the view holds the region and samples outside it */
+    static const char *const settings[] = {"samples=64", "samples=64 masks=hough sample_set=shared"};
+    for (int i = 0; i < 2; i++) {
+        RenderResult r;
+        CHECK(filtered_render(lab, "view_sample_mapping", settings[i], &r));
+        uint64_t pairs = r.frame_work.influence;
+        printf("    view_sample_mapping %s: %llu influence pairs (%llu per sample in the region)\n", settings[i],
+               (unsigned long long)pairs, (unsigned long long)(pairs / 2));
+        render_result_free(&r);
+        CHECK_MSG(pairs % 2 == 0 && pairs / 2 >= (uint64_t)inner && pairs / 2 <= (uint64_t)outer,
+                  "%s: %llu pairs, not two per sample of the quad's influence region (%ld ... %ld samples)",
+                  settings[i], (unsigned long long)pairs, inner, outer);
+    }
+    lab_close(lab);
+}
+
 /* The scenes the registry test renders on: the first whose light 1 a
  * technique handles (sphere, rect, textured rect, directional). */
 static const char *const registry_scenes[] = {"scenes/sphere-on-plane.lua", "scenes/contact.lua",
