@@ -24,6 +24,7 @@ void work_add(WorkCounters *a, const WorkCounters *b)
     a->triangles += b->triangles;
     a->fragments += b->fragments;
     a->edges += b->edges;
+    a->micropatches += b->micropatches;
 }
 
 WorkCounters work_diff(const WorkCounters *later, const WorkCounters *earlier)
@@ -31,7 +32,8 @@ WorkCounters work_diff(const WorkCounters *later, const WorkCounters *earlier)
     return (WorkCounters){later->texel_fetches - earlier->texel_fetches, later->texel_bytes - earlier->texel_bytes,
                           later->ray_calls - earlier->ray_calls,         later->rays - earlier->rays,
                           later->triangles - earlier->triangles,         later->fragments - earlier->fragments,
-                          later->edges - earlier->edges};
+                          later->edges - earlier->edges,
+                          later->micropatches - earlier->micropatches};
 }
 
 static void on_thread_exit(void *block)

@@ -25,6 +25,8 @@ typedef struct WorkCounters {
                              * not counted: a lower bound of a GPU's fragment count under overdraw) */
     uint64_t edges;         /* possible silhouette edges tested against a view sample's cone
                              * (exact_soft.c's exact_for_silhouette: each edge sphere's cone test) */
+    uint64_t micropatches;  /* occluder polygons backprojected onto the light's samples (backprojection.c's
+                             * cover() and contour loops: each micropatch, microquad or microtri, each contour edge) */
 } WorkCounters;
 
 /* This thread's block; register-free to write (work_snapshot finds it).
@@ -58,6 +60,9 @@ static inline void work_raster(uint64_t triangles, uint64_t fragments)
 
 /* n silhouette edges tested against a view sample's cone. */
 static inline void work_edges(uint64_t n) { work_thread.c.edges += n; }
+
+/* n occluder polygons (or contour edges) backprojected onto the light. */
+static inline void work_micropatches(uint64_t n) { work_thread.c.micropatches += n; }
 
 /* The sum over every thread that ever counted (threads that have exited
  * included). Call it from serial code, outside parallel regions: it runs one
