@@ -33,7 +33,9 @@
  *   sweep (only with --only): cost against one axis, --sweep NAME=V1,V2,...
  *     (a parameter of the selected techniques, or a scene key): every round
  *     times each value once; ns per lit candidate, and per lit candidate per
- *     unit of the value, over the first value's (linear: near 1; issue 15);
+ *     unit of the value, over the first value's (linear: near 1; issue 15),
+ *     and ns per micropatch (evaluation time / work.micropatches, the
+ *     occluder polygons backprojected; NaN for a technique that has none);
  *   matched (only with --only): the prefiltered PCSS family (or -t's) over
  *     map sizes 64 ... 2048: penumbra RMSE against the Embree reference
  *     (--samples) and frame time, and the time each needs at pcss's RMSE
@@ -70,7 +72,7 @@
 #define LIGHT_LARGE 0.8
 #define SWEEP_HEADER "technique,axis,value,frame_ms,eval_ms,lit_candidates,eval_ns_per_sample," \
                      "eval_ns_per_sample_per_value,frame_ratio,eval_ratio,frame_per_value_ratio,per_value_ratio," \
-                     WHERE_HEADER
+                     "micropatches,ns_per_micropatch," WHERE_HEADER
 #define CURVE_HEADER "technique,map_size,penumbra_rmse,penumbra_noise_rms,penumbra_samples,frame_ms,eval_ms,note," \
                      WHERE_HEADER
 #define MATCHED_HEADER "technique,target_rmse,pcss_frame_ms,frame_at_target_ms,ratio,pcss_eval_ms,eval_at_target_ms," \
@@ -109,6 +111,7 @@ typedef struct Point {
     double cpu_s, busiest_s; /* the evaluation's CPU seconds: all threads, the busiest (lab.h) */
     long lit; /* lit candidates evaluated (what per-sample costs divide by) */
     double bytes_per_lit; /* texel bytes one evaluation read per lit candidate (core/counters.h) */
+    uint64_t micropatches; /* occluder polygons one evaluation backprojected (core/counters.h) */
 } Point;
 
 static int own_option(void *options, const char *a, const char *v)
@@ -275,7 +278,7 @@ static bool measure(Lab *lab, const Technique *t, const double *params, int repe
     if (!lab_render_timed(lab, &req, &timing, &r, err)) return false;
     double lit = r.lit_candidates > 0 ? (double)r.lit_candidates : NAN; /* none lit: NaN, shown */
     *p = (Point){r.frame_s, r.eval_median_s, r.tech_build_s, 0, r.eval_cpu_s, r.eval_busiest_s, r.lit_candidates,
-                 (double)r.eval_work.texel_bytes / lit};
+                 (double)r.eval_work.texel_bytes / lit, r.eval_work.micropatches};
     for (int i = 0; i < r.num_tech_resources; i++) p->built += r.tech_resources[i].built;
     render_result_free(&r);
     return true;
@@ -595,7 +598,8 @@ static bool light_size(const Options *o, Subject *sj, Error *err)
  * the evaluation's ns per lit candidate and per lit candidate per unit of
  * the value, and the medians of the per-round ratios to the first value:
  * of the frame and evaluation times, and of both per lit candidate per unit
- * of the value (linear in it: near 1). */
+ * of the value (linear in it: near 1); and the median evaluation's ns per
+ * micropatch backprojected (the last round's count: each does the same work). */
 static bool sweep_cost(const Options *o, Subject *sj, Error *err)
 {
     int n = o->num_values, rounds = o->c.repeat > 64 ? 64 : o->c.repeat;
@@ -604,6 +608,7 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
     double params[MAX_POINTS][TECH_MAX_PARAMS], frame[64 * MAX_POINTS], eval[64 * MAX_POINTS];
     Point last[MAX_POINTS];
     long lit[MAX_POINTS] = {0};
+    uint64_t patches[MAX_POINTS] = {0};
     bool ok = true;
     for (int k = 0; ok && k < n; k++) {
         char key[256];
@@ -619,11 +624,15 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
     }
     if (ok) announce(o, sj, "sweep");
     ok = ok && timed_rounds(labs, sj->t, params, n, rounds, frame, eval, last, err);
-    for (int k = 0; ok && k < n; k++) lit[k] = last[k].lit;
+    for (int k = 0; ok && k < n; k++) {
+        lit[k] = last[k].lit;
+        patches[k] = last[k].micropatches;
+    }
     for (int k = 0; ok && k < n; k++) {
         double f = round_median(frame, rounds, n, k), e = round_median(eval, rounds, n, k);
         double per_sample = lit[k] > 0 ? e * 1e9 / (double)lit[k] : NAN; /* no lit candidate: NaN, shown */
         double per_value = o->values[k] != 0.0 ? per_sample / o->values[k] : NAN; /* a choice (NaN) or 0: no unit */
+        double per_patch = patches[k] > 0 ? e * 1e9 / (double)patches[k] : NAN; /* none backprojected: NaN */
         double fr = round_ratio(frame, rounds, n, k, 1.0), er = round_ratio(eval, rounds, n, k, 1.0);
         /* per lit candidate per unit, over the first value's: the lit counts
          * differ with a scene key (a light's size moves the shadow) */
@@ -632,11 +641,14 @@ static bool sweep_cost(const Options *o, Subject *sj, Error *err)
         double pvr = round_ratio(eval, rounds, n, k, scale), fpvr = round_ratio(frame, rounds, n, k, scale);
         char row[4096], end[1024];
         where(sj, lab_scene(labs[k]), o->c.threads, end, sizeof end);
-        snprintf(row, sizeof row, "%s,%s,%s,%.4f,%.4f,%ld,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%s", sj->t->name, o->axis,
-                 o->value_text[k], f * 1e3, e * 1e3, lit[k], per_sample, per_value, fr, er, fpvr, pvr, end);
+        snprintf(row, sizeof row, "%s,%s,%s,%.4f,%.4f,%ld,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%llu,%.3f,%s", sj->t->name,
+                 o->axis, o->value_text[k], f * 1e3, e * 1e3, lit[k], per_sample, per_value, fr, er, fpvr, pvr,
+                 (unsigned long long)patches[k], per_patch, end);
         printf("  %-18s %s %-8s frame %9.3f ms, eval %9.3f ms, %9.2f ns per lit sample, %8.3f per unit; "
-               "ratios to the first: frame %.3f, eval %.3f, per sample per unit: frame %.3f, eval %.3f\n",
-               sj->t->name, o->axis, o->value_text[k], f * 1e3, e * 1e3, per_sample, per_value, fr, er, fpvr, pvr);
+               "ratios to the first: frame %.3f, eval %.3f, per sample per unit: frame %.3f, eval %.3f; "
+               "%.2f ns per micropatch\n",
+               sj->t->name, o->axis, o->value_text[k], f * 1e3, e * 1e3, per_sample, per_value, fr, er, fpvr, pvr,
+               per_patch);
         ok = append(o, "sweep.csv", SWEEP_HEADER, row, err);
     }
     for (int k = 0; k < n; k++)

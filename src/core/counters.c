@@ -25,6 +25,7 @@ void work_add(WorkCounters *a, const WorkCounters *b)
     a->fragments += b->fragments;
     a->edges += b->edges;
     a->influence += b->influence;
+    a->micropatches += b->micropatches;
 }
 
 WorkCounters work_diff(const WorkCounters *later, const WorkCounters *earlier)
@@ -33,7 +34,8 @@ WorkCounters work_diff(const WorkCounters *later, const WorkCounters *earlier)
                           later->ray_calls - earlier->ray_calls,         later->rays - earlier->rays,
                           later->triangles - earlier->triangles,         later->fragments - earlier->fragments,
                           later->edges - earlier->edges,
-                          later->influence - earlier->influence};
+                          later->influence - earlier->influence,
+                          later->micropatches - earlier->micropatches};
 }
 
 static void on_thread_exit(void *block)

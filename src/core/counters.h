@@ -28,6 +28,8 @@ typedef struct WorkCounters {
     uint64_t influence;     /* (caster triangle, view sample) pairs view_sample_mapping maps: the sum of the
                              * triangles' influence regions in view samples (map_triangle's calls, both
                              * mask paths; a sample whose light samples are all hidden takes no more) */
+    uint64_t micropatches;  /* occluder polygons backprojected onto the light's samples (backprojection.c's
+                             * cover() and contour loops: each micropatch, microquad or microtri, each contour edge) */
 } WorkCounters;
 
 /* This thread's block; register-free to write (work_snapshot finds it).
@@ -64,6 +66,8 @@ static inline void work_edges(uint64_t n) { work_thread.c.edges += n; }
 
 /* n (triangle, view sample) pairs of an influence region mapped. */
 static inline void work_influence(uint64_t n) { work_thread.c.influence += n; }
+/* n occluder polygons (or contour edges) backprojected onto the light. */
+static inline void work_micropatches(uint64_t n) { work_thread.c.micropatches += n; }
 
 /* The sum over every thread that ever counted (threads that have exited
  * included). Call it from serial code, outside parallel regions: it runs one

@@ -205,6 +205,7 @@ static void write_counters(JsonWriter *w, const WorkCounters *c)
     json_int(w, "fragments", (long long)c->fragments);
     json_int(w, "edges", (long long)c->edges);
     json_int(w, "influence", (long long)c->influence);
+    json_int(w, "micropatches", (long long)c->micropatches);
 }
 
 /* Machine-independent work (core/counters.h): one evaluation's, the
@@ -229,6 +230,7 @@ static void write_work(JsonWriter *w, const RenderResult *r)
     json_number(w, "texel_bytes", (double)r->eval_work.texel_bytes / n);
     json_number(w, "rays", (double)r->eval_work.rays / n);
     json_number(w, "edges", (double)r->eval_work.edges / n);
+    json_number(w, "micropatches", (double)r->eval_work.micropatches / n);
     json_object_end(w);
     json_object_end(w);
 }

@@ -14,6 +14,8 @@
 #define SL_BACKPROJECT_H
 #include <math.h>
 #include <stdbool.h>
+#include <stdint.h>
+#include <stdlib.h>
 #include "techniques/softmap.h"
 
 /* The stiff case r_z - c_z -> 0 (contact, self-shadowing): a caster at the
@@ -174,6 +176,93 @@ static inline void backproject_light_sample(int tiles, int k, bool square, doubl
     }
     *x = r * cos(phi);
     *y = r * sin(phi);
+}
+
+/* ---- arithmetic-only bitmasks of axis-aligned rectangles ------------------
+ * Schwarz & Stamminger 2007 (course §5.2.3.2): "arithmetic-only updates for
+ * axis-aligned images". [OWN] CPU form (catalogue §5.2.3.2: "4xu64 per mask,
+ * built from row/column ranges"): with the N light samples sorted by x,
+ * below_x[k] is the mask of the first k of them, i.e. of every sample whose
+ * x lies below sorted x[k]; the samples with x < t are then below_x[lower
+ * bound of t], those with x >= t its complement, and a rectangle
+ * [xlo, xhi) x [ylo, yhi) (the half-open rule of backprojection.c's cover())
+ * is
+ *     (below_x(xhi) & ~below_x(xlo)) & (below_y(yhi) & ~below_y(ylo)),
+ * four binary searches and 4 x 4 word operations at N = 256 whatever the
+ * rectangle's size. Coordinates: the light's plane, face axes (world units). */
+#define BACKPROJECT_WORDS (BACKPROJECT_MAX_SAMPLES / 64)
+
+typedef struct BackprojectPrefix {
+    int n, words;                             /* samples; words = ceil(n / 64) per mask */
+    double x[BACKPROJECT_MAX_SAMPLES];        /* the samples' x, ascending */
+    double y[BACKPROJECT_MAX_SAMPLES];        /* their y, ascending */
+    uint64_t below_x[(BACKPROJECT_MAX_SAMPLES + 1) * BACKPROJECT_WORDS]; /* row k (words each): the first k by x */
+    uint64_t below_y[(BACKPROJECT_MAX_SAMPLES + 1) * BACKPROJECT_WORDS];
+} BackprojectPrefix;
+
+typedef struct BackprojectKey { double v; int sample; } BackprojectKey;
+
+static inline int backproject_key_order(const void *a, const void *b)
+{
+    double u = ((const BackprojectKey *)a)->v, w = ((const BackprojectKey *)b)->v;
+    return (u > w) - (u < w);
+}
+
+/* One axis: coordinates v[0..n) (finite) sorted into sorted[], prefix masks into below[]. */
+static inline void backproject_prefix_axis(const float *v, int n, int words, double *sorted, uint64_t *below)
+{
+    BackprojectKey key[BACKPROJECT_MAX_SAMPLES];
+    for (int k = 0; k < n; k++) key[k] = (BackprojectKey){v[k], k};
+    qsort(key, (size_t)n, sizeof key[0], backproject_key_order);
+    for (int w = 0; w < words; w++) below[w] = 0;
+    for (int k = 0; k < n; k++) {
+        sorted[k] = key[k].v;
+        uint64_t *row = below + (size_t)(k + 1) * words;
+        for (int w = 0; w < words; w++) row[w] = row[w - words];
+        row[key[k].sample >> 6] |= 1ull << (key[k].sample & 63);
+    }
+}
+
+/* The prefix masks of n <= BACKPROJECT_MAX_SAMPLES samples at (x[k], y[k]). */
+static inline void backproject_prefix_init(BackprojectPrefix *pm, const float *x, const float *y, int n)
+{
+    pm->n = n;
+    pm->words = (n + 63) / 64;
+    backproject_prefix_axis(x, n, pm->words, pm->x, pm->below_x);
+    backproject_prefix_axis(y, n, pm->words, pm->y, pm->below_y);
+}
+
+/* How many of the ascending v[0..n) lie below t (t not NaN). */
+static inline int backproject_count_below(const double *v, int n, double t)
+{
+    int lo = 0, hi = n;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (v[mid] < t) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* OR into mask (NULL: none) the samples in [xlo, xhi) x [ylo, yhi); returns
+ * how many there are. A NaN bound or an empty range holds none (as the
+ * per-sample comparisons, which NaN fails). */
+static inline int backproject_rect_mask(const BackprojectPrefix *pm, double xlo, double xhi, double ylo, double yhi,
+                                        uint64_t *mask)
+{
+    if (!(xlo < xhi && ylo < yhi)) return 0;
+    int w = pm->words;
+    const uint64_t *x0 = pm->below_x + (size_t)backproject_count_below(pm->x, pm->n, xlo) * w;
+    const uint64_t *x1 = pm->below_x + (size_t)backproject_count_below(pm->x, pm->n, xhi) * w;
+    const uint64_t *y0 = pm->below_y + (size_t)backproject_count_below(pm->y, pm->n, ylo) * w;
+    const uint64_t *y1 = pm->below_y + (size_t)backproject_count_below(pm->y, pm->n, yhi) * w;
+    int marked = 0;
+    for (int k = 0; k < w; k++) {
+        uint64_t in = x1[k] & ~x0[k] & y1[k] & ~y0[k];
+        if (mask) mask[k] |= in;
+        marked += __builtin_popcountll(in);
+    }
+    return marked;
 }
 
 #endif

@@ -63,6 +63,7 @@
  * path a receiver took (0 lit early out, 1 umbra early out, 2
  * backprojected); `blend` mixes two budget levels. */
 #include <stdlib.h>
+#include "core/counters.h"
 #include "core/nanmath.h"
 #include "resources/maps/peeled.h"
 #include "techniques/backproject.h"
@@ -83,7 +84,7 @@ static const char *const early_out_names[] = {"both", "lit", "none", NULL};
 enum { CLASS_LIT, CLASS_UMBRA, CLASS_BACKPROJECTED }; /* aux `class` */
 
 #define BP_MAX_BUDGET 256
-#define BP_WORDS (BACKPROJECT_MAX_SAMPLES / 64)
+#define BP_WORDS BACKPROJECT_WORDS
 #define BP_MAX_HSM_LEVELS 15 /* a 16384^2 map's pyramid */
 
 /* Plain perspective faces only (softmap.h): no warps or frustum-face splits. */
@@ -156,7 +157,9 @@ static const char *const ms_aux[] = {"class", "level", NULL};
 
 /* The light's samples on one face's light plane (world units, face axes),
  * bucketed on a G x G grid over the light's bounding box, so a polygon
- * tests only the samples under its bounding box. */
+ * tests only the samples under its bounding box; and sorted by x and by y
+ * with prefix masks (backproject.h), so an axis-aligned rectangle (a
+ * micropatch's image) takes its mask by arithmetic alone. */
 #define BP_GRID 16
 typedef struct FaceSamples {
     float x[BACKPROJECT_MAX_SAMPLES], y[BACKPROJECT_MAX_SAMPLES];
@@ -164,6 +167,7 @@ typedef struct FaceSamples {
     short start[BP_GRID * BP_GRID + 1];
     short index[BACKPROJECT_MAX_SAMPLES];
     double x0, y0, cell_x, cell_y; /* the grid's corner and cell size */
+    BackprojectPrefix prefix;
 } FaceSamples;
 
 /* One depth layer's min-depth structures (layer 0: the map's own): the
@@ -220,6 +224,7 @@ static void face_samples(const Light *light, const SoftLight *L, int tiles, int 
     int fill[BP_GRID * BP_GRID];
     for (int c = 0; c < BP_GRID * BP_GRID; c++) fill[c] = fs->start[c];
     for (int k = 0; k < n; k++) fs->index[fill[cell[k]]++] = (short)k;
+    backproject_prefix_init(&fs->prefix, fs->x, fs->y, n);
 }
 
 /* Nodes per side of pyramid level `level` over a res^2 map, and the
@@ -481,8 +486,10 @@ static bool poly_contains(const Poly *p, double x, double y)
 }
 
 /* Mark the samples the polygon covers in mask (NULL: count only; rect: an
- * axis-aligned box, corners (x[0], y[0]) and (x[1], y[1])); returns how
- * many it covers. */
+ * axis-aligned box, corners (x[0], y[0]) and (x[1], y[1]), half-open
+ * [xlo, xhi) x [ylo, yhi), its mask from the prefix masks with no sample
+ * tested, course §5.2.3.2); returns how many it covers. Each call is one
+ * occluder polygon backprojected (work.micropatches). */
 static int cover(const FaceSamples *fs, const Poly *p, bool rect, uint64_t *mask)
 {
     double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
@@ -493,7 +500,9 @@ static int cover(const FaceSamples *fs, const Poly *p, bool rect, uint64_t *mask
         if (p->y[k] < ylo) ylo = p->y[k];
         if (p->y[k] > yhi) yhi = p->y[k];
     }
+    work_micropatches(1);
     if (!(xlo <= -fs->x0 && xhi >= fs->x0 && ylo <= -fs->y0 && yhi >= fs->y0)) return 0; /* off the light, or NaN */
+    if (rect) return backproject_rect_mask(&fs->prefix, xlo, xhi, ylo, yhi, mask);
     int c0 = grid_cell(xlo, fs->x0, fs->cell_x), c1 = grid_cell(xhi, fs->x0, fs->cell_x);
     int r0 = grid_cell(ylo, fs->y0, fs->cell_y), r1 = grid_cell(yhi, fs->y0, fs->cell_y);
     int marked = 0;
@@ -501,8 +510,7 @@ static int cover(const FaceSamples *fs, const Poly *p, bool rect, uint64_t *mask
         for (int k = fs->start[row * BP_GRID + c0]; k < fs->start[row * BP_GRID + c1 + 1]; k++) {
             int s = fs->index[k];
             double x = fs->x[s], y = fs->y[s];
-            bool in = rect ? x >= xlo && x < xhi && y >= ylo && y < yhi : poly_contains(p, x, y);
-            if (!in) continue;
+            if (!poly_contains(p, x, y)) continue;
             if (mask) mask[s >> 6] |= 1ull << (s & 63);
             marked++;
         }
@@ -706,6 +714,7 @@ static void contour_occlusion(const BpState *st, const SoftLight *L, const FaceS
                     o->unknown = true;
                     continue;
                 }
+                work_micropatches(1); /* one contour edge backprojected */
                 if (st->accumulate == ACC_AREA)
                     share += radial_share(L, p, q);
                 else

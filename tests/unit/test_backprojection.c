@@ -31,6 +31,70 @@ TEST(test_backprojection_singular_receiver_depth_is_guarded)
     CHECK_NEAR(k * (x - u), (p_z * (x * z) - z * (u * p_z)) / (p_z - z), 1e-12);
 }
 
+/* backproject.h's prefix masks against the per-sample rule they replace in
+ * cover() (x >= xlo && x < xhi && y >= ylo && y < yhi: NaN fails every
+ * comparison): identical masks and counts on random rectangles whose edges
+ * lie exactly on sample coordinates, one ulp either side, anywhere, at
+ * +-infinity or NaN; samples of the RGSS tiling (square and disk, rotated
+ * into face axes) and a set with tied coordinates. 20 ms. */
+static double rect_edge(const float *v, int n, unsigned *seed)
+{
+    *seed = *seed * 1103515245u + 12345u;
+    unsigned r = *seed >> 8, pick = r % 16;
+    double on = v[(r / 16) % (unsigned)n];
+    if (pick < 6) return on;
+    if (pick < 8) return nextafter(on, INFINITY);
+    if (pick < 10) return nextafter(on, -INFINITY);
+    if (pick == 10) return -INFINITY;
+    if (pick == 11) return INFINITY;
+    if (pick == 12) return NAN;
+    return -1.5 + 3.0 * (double)(r % 65536) / 65536.0;
+}
+
+static bool prefix_matches_per_sample(const float *x, const float *y, int n, unsigned seed)
+{
+    static BackprojectPrefix pm;
+    backproject_prefix_init(&pm, x, y, n);
+    for (int trial = 0; trial < 4000; trial++) {
+        double xlo = rect_edge(x, n, &seed), xhi = rect_edge(x, n, &seed);
+        double ylo = rect_edge(y, n, &seed), yhi = rect_edge(y, n, &seed);
+        uint64_t got[BACKPROJECT_WORDS] = {0}, want[BACKPROJECT_WORDS] = {0};
+        int count = backproject_rect_mask(&pm, xlo, xhi, ylo, yhi, got), want_count = 0;
+        for (int s = 0; s < n; s++)
+            if (x[s] >= xlo && x[s] < xhi && y[s] >= ylo && y[s] < yhi) {
+                want[s >> 6] |= 1ull << (s & 63);
+                want_count++;
+            }
+        for (int k = 0; k < BACKPROJECT_WORDS; k++)
+            if (got[k] != want[k]) return false;
+        if (count != want_count || backproject_rect_mask(&pm, xlo, xhi, ylo, yhi, NULL) != want_count) return false;
+    }
+    return true;
+}
+
+TEST(test_backprojection_prefix_rect_mask_matches_per_sample_test)
+{
+    static float x[BACKPROJECT_MAX_SAMPLES], y[BACKPROJECT_MAX_SAMPLES];
+    const double M[2][2] = {{0.6, -0.8}, {0.8, 0.6}}; /* a rotated light's axes, as softmap.h's M */
+    for (int square = 0; square <= 1; square++)
+        for (int tiles = 1; tiles <= 16; tiles *= 4) {
+            int n = 4 * tiles * tiles;
+            for (int k = 0; k < n; k++) {
+                double a, b;
+                backproject_light_sample(tiles, k, square, &a, &b);
+                x[k] = (float)(square ? a : M[0][0] * a + M[0][1] * b);
+                y[k] = (float)(square ? b : M[1][0] * a + M[1][1] * b);
+            }
+            CHECK_MSG(prefix_matches_per_sample(x, y, n, 7u + (unsigned)n), "tiles %d square %d", tiles, square);
+        }
+    for (int k = 0; k < 256; k++) { /* ties: 16 distinct values per axis */
+        x[k] = (float)((k * 7) % 16) / 8.0f - 1.0f;
+        y[k] = (float)((k * 5 / 3) % 16) / 8.0f - 1.0f;
+    }
+    CHECK(prefix_matches_per_sample(x, y, 256, 99u));
+    CHECK(prefix_matches_per_sample(x, y, 1, 5u)); /* N = 1 */
+}
+
 /* Light: 1 x 1 square at y = 4 facing down; occluder: 0.8 x 0.8 square at
  * y = 2, parallel to it; ground at y = 0. */
 static const char *const square_scene =

@@ -225,6 +225,33 @@ TEST(test_counters_vsm_influence_is_the_quads_footprint)
     lab_close(lab);
 }
 
+/* work.micropatches: backprojection counts each occluder polygon it
+ * backprojects onto the light (cover()), whichever way it accumulates them
+ * (the same polygons reach the samples under bitmask and area), and a
+ * technique that backprojects none counts none. */
+TEST(test_counters_backprojection_counts_its_micropatches)
+{
+    Lab *lab = filtered_open("scenes/sphere-on-plane.lua", COUNT_W, COUNT_H);
+    CHECK(lab);
+    static const char *const settings[] = {"occluder=micropatch accumulate=bitmask map_size=128",
+                                           "occluder=micropatch accumulate=area map_size=128"};
+    uint64_t counted[2] = {0, 0};
+    for (int i = 0; i < 2; i++) {
+        RenderResult r;
+        CHECK(filtered_render(lab, "backprojection", settings[i], &r));
+        counted[i] = r.eval_work.micropatches;
+        printf("    backprojection %s: %llu micropatches, %ld lit candidates\n", settings[i],
+               (unsigned long long)counted[i], r.lit_candidates);
+        render_result_free(&r);
+    }
+    CHECK(counted[0] > 0 && counted[0] == counted[1]);
+    RenderResult r;
+    CHECK(filtered_render(lab, "pcf", "map_size=128", &r));
+    CHECK(r.eval_work.micropatches == 0);
+    render_result_free(&r);
+    lab_close(lab);
+}
+
 /* The scenes the registry test renders on: the first whose light 1 a
  * technique handles (sphere, rect, textured rect, directional). */
 static const char *const registry_scenes[] = {"scenes/sphere-on-plane.lua", "scenes/contact.lua",
