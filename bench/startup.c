@@ -113,7 +113,7 @@ int main(int argc, char **argv)
     }
     char *list[] = {(char *)bin, "list", NULL}, *help[] = {(char *)bin, "render", "--help", NULL};
     char *render[MAX_ARGS] = {(char *)bin, "render", "scenes/sphere-on-plane.lua", "-t", "hard", "--no-png",
-                              "--no-cache", "--threads", "1", "-s", "camera.width=32", "-s", "camera.height=24",
+                              "--threads", "1", "-s", "camera.width=32", "-s", "camera.height=24",
                               "-o", out, NULL};
     Error err;
     bool ok = bench_command("list", list, repeat, dir, &err) && bench_command("render --help", help, repeat, dir, &err) &&
