@@ -604,6 +604,10 @@ static void mask_visibility(const BpState *st, const FaceSamples *fs, const uint
 {
     int marked = 0;
     for (int k = 0; k < BP_WORDS; k++) marked += __builtin_popcountll(mask[k]);
+    if (st->channels == 1) { /* an untextured light: every sample white, V = 1 - popcount / N */
+        v[0] = share_visibility((double)marked / st->samples, unknown); /* samples = 4 tiles^2 >= 4 */
+        return;
+    }
     float lit[3];
     light_bitmask_visibility(fs->colour, st->all, mask, st->samples, st->channels, lit);
     for (int c = 0; c < st->channels; c++) v[c] = marked >= st->samples ? 0.0 : unknown ? NAN : lit[c];
