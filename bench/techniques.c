@@ -16,7 +16,10 @@
  *     largest K within 1.2x of the smallest (the papers' claim);
  *   threads: each technique's evaluation, and the Embree reference, on the
  *     curve 1, 2, 4, ... N threads (bench.h's BenchCurve), with the CPU time
- *     a technique's threads ran (lab.h's eval_cpu_s, eval_busiest_s);
+ *     a technique's threads ran (lab.h's eval_cpu_s, eval_busiest_s); a
+ *     point's time is the median of as many evaluations as take about
+ *     SCALING_MIN_S at one thread (the count fixed in the warm-up round), so
+ *     a 7 ms evaluation is not one scheduler tick's worth of noise;
  *   lightsize: every soft technique that handles sphere lights at light 1's
  *     radius 0.05 and 0.8 (map_size 2048 where it has one; --quick: 1024;
  *     -p map_size=N: N; where it refuses that size, the largest half it accepts),
@@ -64,7 +67,7 @@
 #define WHERE_HEADER "scene,light,settings,width,height," BENCH_TAIL_HEADER "\n"
 #define GROWTH_HEADER "technique,axis,value,frame_ms,eval_ms,build_ms,resources_built,note," WHERE_HEADER
 #define CONSTANT_HEADER "technique,prefilter,K_min,K_max,frame_min_ms,frame_max_ms,ratio,bound,within," WHERE_HEADER
-#define THREADS_HEADER "technique,ms_1,ms_n,speedup,cpu_ms_1,cpu_ms_n,busiest_ms_n,cpu_bound," WHERE_HEADER
+#define THREADS_HEADER "technique,ms_1,ms_n,speedup,cpu_ms_1,cpu_ms_n,busiest_ms_n,cpu_bound,evals," WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
                           "eval_small_ms,eval_large_ms,eval_ratio,bytes_small,bytes_large,bytes_ratio,note," \
                           WHERE_HEADER
@@ -848,7 +851,21 @@ typedef struct Scaling {
      * calls[k] the runs so far */
     double *cpu, *busiest;
     int calls[BENCH_MAX_CURVE];
+    int repeat; /* evaluations a timed point takes the median of (0: not yet fixed) */
 } Scaling;
+
+/* A point's evaluations together take about this long at one thread, at most
+ * SCALING_MAX_REPEAT of them (seconds). */
+#define SCALING_MIN_S 0.1
+#define SCALING_MAX_REPEAT 32
+
+/* Evaluations per timed point: enough that one thread's take SCALING_MIN_S,
+ * from the first (warm-up) evaluation's time eval_s. */
+static int scaling_repeat(double eval_s)
+{
+    double n = eval_s > 0.0 ? ceil(SCALING_MIN_S / eval_s) : SCALING_MAX_REPEAT; /* below the clock: the most */
+    return n < 1.0 ? 1 : n > SCALING_MAX_REPEAT ? SCALING_MAX_REPEAT : (int)n;
+}
 
 /* The point of s's curve at `threads`. */
 static int curve_point(const Scaling *s, int threads)
@@ -865,9 +882,10 @@ static bool scaled_once(void *ctx, int side, int threads, double *seconds, Error
     (void)side;
     if (s->sj->t) {
         Point p;
-        if (!measure(s->lab, s->sj->t, s->sj->params, 1, &p, err)) return false;
+        if (!measure(s->lab, s->sj->t, s->sj->params, s->repeat > 0 ? s->repeat : 1, &p, err)) return false;
         *seconds = p.eval_s;
         int k = curve_point(s, threads), i = s->calls[k]++;
+        if (s->repeat == 0) s->repeat = scaling_repeat(p.eval_s); /* the warm-up at one thread */
         s->cpu[k * (s->c->rounds + 1) + i] = p.cpu_s;
         s->busiest[k * (s->c->rounds + 1) + i] = p.busiest_s;
         return true;
@@ -913,13 +931,14 @@ static bool scaling_rows(const Options *o, const Scaling *s, const BenchCurve *c
     const char *name = s->sj->t ? s->sj->t->name : "reference";
     bool ok = true;
     double ms1 = bench_curve_median_s(c, 0, 0) * 1e3;
-    printf("  %-18s 1 thread %9.3f ms", name, ms1);
+    printf("  %-18s 1 thread %9.3f ms (median of %d)", name, ms1, s->repeat > 0 ? s->repeat : 1);
     for (int k = 0; ok && k < c->points; k++) {
         char row[2048], end[1024], cpu[256];
         double msk = bench_curve_median_s(c, 0, k) * 1e3, speedup = bench_curve_speedup(c, 0, k), bound;
         where(s->sj, lab_scene(s->lab), c->threads[k], end, sizeof end);
         cpu_columns(s, k, cpu, sizeof cpu, &bound);
-        snprintf(row, sizeof row, "%s,%.4f,%.4f,%.3f,%s,%s", name, ms1, msk, speedup, cpu, end);
+        snprintf(row, sizeof row, "%s,%.4f,%.4f,%.3f,%s,%d,%s", name, ms1, msk, speedup, cpu, s->repeat > 0 ? s->repeat : 1,
+                 end);
         if (k > 0) printf("; %d: %.3f ms, speed-up %.2f", c->threads[k], msk, speedup);
         if (k > 0 && s->sj->t)
             printf(" (CPU bound %.2f, CPU %.2fx of 1 thread's)", bound,
