@@ -10,7 +10,7 @@
 #include "core/error.h"
 #include "lab/lab.h"
 #include "raster/raster.h"
-#include "resources/shadowmap.h"
+#include "resources/maps/shadowmap.h"
 
 /* The columns bench_tail fills, at the end of every header. */
 #define BENCH_TAIL_HEADER "threads,commit,cpu_model,load_1min,date"

@@ -1,6 +1,6 @@
 /* geometry.c -- the geometry family's costs (issue 14's bench items).
  *   --silhouette: the silhouette resource (edge adjacency and possible
- *     silhouette edges for light 1's centre, src/resources/silhouette.c)
+ *     silhouette edges for light 1's centre, src/resources/geometry/silhouette.c)
  *     built from scratch on sphere-on-plane's ball at 16 ... 1024 segments
  *     (about segments^2 triangles: 256 ... 1M): nanoseconds per triangle at
  *     each size, and the largest size's over the smallest (linear in
@@ -31,7 +31,7 @@
 #include <string.h>
 #include "bench.h"
 #include "core/timer.h"
-#include "resources/silhouette.h"
+#include "resources/geometry/silhouette.h"
 #include "rt/rt.h"
 
 #define SIL_HEADER "segments,triangles,silhouette_edges,build_ms,ns_per_triangle,ns_per_triangle_over_smallest," \

@@ -5,7 +5,7 @@
 -- frustum-face partitioning (FP, uniform per face, and FP+W, warped per face,
 -- at the number of light-facing faces), with an overhead light (ideal for
 -- warping) and with the light behind the viewer (no warping possible).
--- Measured by lab:aliasing's frustum measure (resources/aliasing.h): Lloyd's
+-- Measured by lab:aliasing's frustum measure (resources/analysis/aliasing.h): Lloyd's
 -- maximum perspective aliasing error over the view frustum (each point's
 -- normal bisects eye and light directions), probed at N x N rays (image
 -- edges and corners included) x N depths along each (its ends in B

@@ -1,6 +1,6 @@
 -- fig3-7-aliasing-vs-z.lua -- course Fig. 3.7: the perspective aliasing
 -- error along the view axis for an overhead directional light, measured by
--- the instrument (lab:aliasing, resources/aliasing.h) on the maps the lab
+-- the instrument (lab:aliasing, resources/analysis/aliasing.h) on the maps the lab
 -- actually builds, over the analytic curves of the catalogue (course §3.1.2,
 -- [OWN] closed forms, here checked): uniform, PSM (Stamminger & Drettakis),
 -- LiSPSM with n_opt = z_n + sqrt(z_f z_n) (Wimmer 2004), plus LogPSM's

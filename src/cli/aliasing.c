@@ -1,5 +1,5 @@
 /* aliasing.c -- `shadowlab aliasing SCENE [-t TECH] [-p K=V]...`: the
- * sampling-error analysis (course §3.1; resources/aliasing.h) of the shadow
+ * sampling-error analysis (course §3.1; resources/analysis/aliasing.h) of the shadow
  * map a technique renders with -- any projection, warp, fit or cascades of
  * the shared map parameters -- over the view samples, and Lloyd's storage
  * factor over the view frustum; writes lab/aliasing_report.h's files and prints

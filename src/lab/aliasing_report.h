@@ -1,5 +1,5 @@
 /* aliasing_report.h -- the outputs of a sampling-error analysis
- * (resources/aliasing.h): a float EXR of the per-sample readings, a
+ * (resources/analysis/aliasing.h): a float EXR of the per-sample readings, a
  * colour-mapped PNG of m (Lloyd's scale: blue oversampled, green at m = 1,
  * through yellow and red to dark red at m >= 10), a PNG of the cascade
  * each sample uses (course Figs. 3.10-3.12), the histogram and the profile
@@ -8,7 +8,7 @@
 #ifndef SL_ALIASING_REPORT_H
 #define SL_ALIASING_REPORT_H
 #include <stdio.h>
-#include "resources/aliasing.h"
+#include "resources/analysis/aliasing.h"
 
 typedef struct AliasingReport {
     const Scene *scene;

@@ -1,5 +1,5 @@
 /* laliasing.c -- lab:aliasing{...}: the sampling-error analysis of course
- * §3.1 (resources/aliasing.h) from Lua, on the Lab's resources (a sweep
+ * §3.1 (resources/analysis/aliasing.h) from Lua, on the Lab's resources (a sweep
  * reuses maps and view samples like render and compare do):
  *   lab:aliasing{technique = "sm", params = {projection = "lispsm", fit = "body"},
  *                light = 1, axis = {1, 2, 5, ...}, frustum = 24, image = false}
@@ -18,7 +18,7 @@
  *            persp_t_mean}, ...}}. */
 #include <string.h>
 #include "lua/sl_lua.h"
-#include "resources/aliasing.h"
+#include "resources/analysis/aliasing.h"
 #include "techniques/smap.h"
 
 static const char *const option_names[] = {"technique", "params", "light", "axis", "frustum", "image", NULL};

@@ -12,8 +12,8 @@
  * image, averaged over the light (Fig. 3). The level reached is the aux
  * channel `level` (Table 2, Fig. 2). */
 #include <stdlib.h>
-#include "resources/prefilter.h"
-#include "resources/lightimage.h"
+#include "resources/maps/prefilter.h"
+#include "resources/maps/lightimage.h"
 #include "techniques/smap.h"
 
 enum { P_THRESHOLD = SMAP_NUM_PARAMS, P_MAX_LEVEL, P_COLOR_THRESHOLD, P_FIXED, P_TAPS, P_SEARCH_TAPS };
@@ -187,7 +187,7 @@ static bool region_texel(const Region *g, double u, double v, int *i, int *j)
  * Cut at the map's near plane the cone is needlessly wide wherever the near
  * plane lies far in front of the casters (a ground plane reaching toward
  * the light), so it is cut again at the nearest caster inside its bounding
- * box, read from the min-max pyramid (resources/prefilter.h), a few times (course §5.2.3.4's
+ * box, read from the min-max pyramid (resources/maps/prefilter.h), a few times (course §5.2.3.4's
  * search area refined through z_min, Fig. 5.9): no blocker can lie in front
  * of that plane, so the region stays conservative. 0: nothing in front of
  * the receiver, lit. */

@@ -3,13 +3,13 @@
  * fits, cascades) can be measured by the CLI, Lua sweeps and the stability
  * suite alike. Its visibility is the map's nearest-texel test (what `sm`
  * with single layers gives); its auxiliary channels are the instrument's
- * readings per sample (resources/aliasing.h): m = max(m_s, m_t), m_s and
+ * readings per sample (resources/analysis/aliasing.h): m = max(m_s, m_t), m_s and
  * m_t (pixels per texel step along each map axis; > 1 undersampled), the
  * projection factor cos(alpha)/cos(beta) of Eq. 3.1, and the cascade used
  * (1-based; 0 where nothing was measured). `shadowlab aliasing` writes the
  * full report (colour map, histogram, profile along depth, storage). */
 #include <stdlib.h>
-#include "resources/aliasing.h"
+#include "resources/analysis/aliasing.h"
 #include "techniques/smap.h"
 
 static const ParamDesc aliasing_params[] = {

@@ -22,7 +22,7 @@
 #include <string.h>
 #include "core/hash.h"
 #include "core/counters.h"
-#include "resources/silhouette.h"
+#include "resources/geometry/silhouette.h"
 #include "resources/standard.h"
 
 const char *const exact_pattern_names[] = {"r2", "stratified", "random", NULL}; /* SamplingPattern order */

@@ -96,7 +96,7 @@ typedef struct ExactCasters {
     Ball *chunk_ball;
     int *object_first; /* per caster object: its first chunk; num_objects + 1 */
     Ball *object_ball;
-    bool *object_closed; /* a closed 2-manifold (resources/silhouette.h's adjacency) */
+    bool *object_closed; /* a closed 2-manifold (resources/geometry/silhouette.h's adjacency) */
     int *tri_chunk;      /* per triangle: its chunk */
     dvec3 *tri_normal;   /* per triangle: (t1 - t0) x (t2 - t0), world */
     int8_t *tri_light_side; /* per triangle: which side of its plane the light's ball lies on (exact_soft.c) */

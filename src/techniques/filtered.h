@@ -2,7 +2,7 @@
  * (vsm, lvsm, evsm, msm in vsm.c; esm.c; csm.c) share: the filter's
  * parameters, declared once and expanded after SMAP_MAP_PARAMS and
  * SMAP_DEPTH_BIAS_PARAMS (no receiver plane: see below); the chain of keyed resources depth map -> moment map ->
- * box blur or SAT (resources/prefilter.h); and the lookup of a view sample:
+ * box blur or SAT (resources/maps/prefilter.h); and the lookup of a view sample:
  * its normalised reference depth and the window's filtered moments.
  *
  * The reference depth is the lead's biased smap_receiver depth at the
@@ -11,7 +11,7 @@
  * among its own parameters. */
 #ifndef SL_FILTERED_H
 #define SL_FILTERED_H
-#include "resources/prefilter.h"
+#include "resources/maps/prefilter.h"
 #include "techniques/smap.h"
 
 extern const char *const filter_prefilter_names[];

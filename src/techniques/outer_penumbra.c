@@ -1,6 +1,6 @@
 /* outer_penumbra.c -- the outer-penumbra geometry methods of course §5.3.1:
  * a hard shadow map for the umbra, and a light-space buffer, drawn from the
- * light centre's silhouette edges (resources/silhouette.h), that softens
+ * light centre's silhouette edges (resources/geometry/silhouette.h), that softens
  * the region outside it.
  *
  *   `smoothies` (Chan & Durand 2003, "Rendering fake soft shadows with
@@ -76,7 +76,7 @@
 #include <stdlib.h>
 #include "core/counters.h"
 #include "raster/segment.h"
-#include "resources/silhouette.h"
+#include "resources/geometry/silhouette.h"
 #include "rt/outer.h"
 #include "techniques/softmap.h"
 

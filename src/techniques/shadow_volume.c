@@ -1,7 +1,7 @@
 /* shadow_volume.c -- `shadow_volume`: Crow's shadow volumes counted per view
  * sample (course §2.2). The volume of the casters for the light's centre is
  * the possible silhouette edges' quads, extruded away from the centre
- * (resources/silhouette.h: Bergeron's rule on meshes that are not closed, so
+ * (resources/geometry/silhouette.h: Bergeron's rule on meshes that are not closed, so
  * open and non-manifold meshes are handled, not refused), and for z-fail the
  * caps: the triangles turned toward the centre, and the same triangles
  * extruded (far cap). The camera-space pass (raster/camera_count.h) counts
@@ -17,7 +17,7 @@
 #include <string.h>
 #include "core/hash.h"
 #include "raster/camera_count.h"
-#include "resources/silhouette.h"
+#include "resources/geometry/silhouette.h"
 #include "resources/standard.h"
 #include "techniques/shadow_volume.h"
 

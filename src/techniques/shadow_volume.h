@@ -4,7 +4,7 @@
 #ifndef SL_SHADOW_VOLUME_H
 #define SL_SHADOW_VOLUME_H
 #include "raster/raster.h"
-#include "resources/silhouette.h"
+#include "resources/geometry/silhouette.h"
 #include "techniques/technique.h"
 
 /* z-fail (Carmack's reverse) counts of the infinite volume of `sil`'s point,

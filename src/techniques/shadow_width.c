@@ -10,7 +10,7 @@
  * §5's self-shadowing treatment renders the depth map from the farthest back
  * faces instead (a z-greater test). */
 #include <stdlib.h>
-#include "resources/shadowwidth.h"
+#include "resources/maps/shadowwidth.h"
 #include "techniques/smap.h"
 
 enum { P_C_SCALE = SMAP_NUM_PARAMS, P_C_BIAS, P_NEIGHBOURS, P_START_DIFFERENCE, P_SELF_SHADOW, P_FILTER };

@@ -11,8 +11,8 @@ const char *const smap_falloff_names[] = {WARP_FALLOFF_NAMES, NULL};
 const char *const smap_split_names[] = {SPLIT_SCHEME_NAMES, NULL};
 const char *const smap_select_names[] = {CASCADE_SELECT_NAMES, NULL};
 
-/* What each view parameter shapes (resources/shadowmap.c's relevant_params,
- * resources/warp.c's warp_n, lightview.c's fit_face): a warp's n and falloff
+/* What each view parameter shapes (resources/maps/shadowmap.c's relevant_params,
+ * resources/views/warp.c's warp_n, lightview.c's fit_face): a warp's n and falloff
  * (lispsm, logpsm; tsm's falloff), a free n, TSM's focus, the splits of a
  * partitioned map (cascades, or the frustum's faces), stable extents
  * (unwarped faces: ortho and perspective maps, also per cascade, and the

@@ -12,7 +12,7 @@
 #define SL_SMAP_H
 #include <string.h>
 #include "core/nanmath.h"
-#include "resources/shadowmap.h"
+#include "resources/maps/shadowmap.h"
 #include "techniques/technique.h"
 
 extern const char *const smap_projection_names[];

@@ -1,6 +1,6 @@
 /* soft_shadow_volume.c -- the wedge family of course §5.3.2: `soft_shadow_volume`
  * (Assarsson & Akenine-Möller 2003) and `penumbra_wedge` (Akenine-Möller &
- * Assarsson 2002), on the hard volume's machinery (resources/silhouette.h,
+ * Assarsson 2002), on the hard volume's machinery (resources/geometry/silhouette.h,
  * techniques/shadow_volume.h).
  *
  * Both start from the silhouette edges of one point c of the light (the
@@ -63,7 +63,7 @@
 #include "core/mat4.h"
 #include "core/nanmath.h"
 #include "raster/camera_count.h"
-#include "resources/silhouette.h"
+#include "resources/geometry/silhouette.h"
 #include "rt/view.h"
 #include "techniques/shadow_volume.h"
 #include "techniques/radial_area.h"

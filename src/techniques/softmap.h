@@ -11,7 +11,7 @@
  * or receiver at tangent (u, v) and depth z sits at (u z, v z, z). */
 #ifndef SL_SOFTMAP_H
 #define SL_SOFTMAP_H
-#include "resources/prefilter.h"
+#include "resources/maps/prefilter.h"
 #include "techniques/smap.h"
 
 #define SOFTMAP_MAX_POISSON 1024

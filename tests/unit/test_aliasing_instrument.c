@@ -1,4 +1,4 @@
-/* test_aliasing_instrument.c -- the aliasing instrument (resources/aliasing.h,
+/* test_aliasing_instrument.c -- the aliasing instrument (resources/analysis/aliasing.h,
  * course §3.1) against truths it does not compute itself: Lloyd et al.
  * 2006's storage factor over the view frustum against a closed form of the
  * uniform map's error (and its convergence in the number of points where no
@@ -12,8 +12,8 @@
 #include "core/fsutil.h"
 #include "fixtures.h"
 #include "lab/aliasing_report.h"
-#include "resources/aliasing.h"
-#include "resources/warp.h"
+#include "resources/analysis/aliasing.h"
+#include "resources/views/warp.h"
 #include "techniques/smap.h"
 #include "test.h"
 

@@ -13,7 +13,7 @@
 #include <string.h>
 #include "filtered_fixtures.h"
 #include "fixtures.h"
-#include "resources/prefilter.h"
+#include "resources/maps/prefilter.h"
 #include "techniques/smap.h"
 #include "test.h"
 

@@ -14,7 +14,7 @@
  * 128 x 96 and 160 x 120 views, 256^2 and 512^2 maps, 256-sample references. */
 #include <math.h>
 #include "fixtures.h"
-#include "resources/prefilter.h"
+#include "resources/maps/prefilter.h"
 #include "signed_error.h"
 #include "soft_helpers.h"
 #include "techniques/filtsoft.h"

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "fixtures.h"
-#include "resources/prefilter.h"
+#include "resources/maps/prefilter.h"
 #include "resources/standard.h"
 #include "soft_helpers.h"
 #include "techniques/smap.h"

@@ -8,7 +8,7 @@
 #include <string.h>
 #include "fixtures.h"
 #include "raster/camera_count.h"
-#include "resources/silhouette.h"
+#include "resources/geometry/silhouette.h"
 #include "test.h"
 
 /* Disagreeing samples may lie this many ray offsets (rt_ray_offset) from a

@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "fixtures.h"
-#include "resources/shadowwidth.h"
+#include "resources/maps/shadowwidth.h"
 #include "signed_error.h"
 #include "soft_helpers.h"
 #include "test.h"

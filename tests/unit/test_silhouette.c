@@ -1,12 +1,12 @@
 /* test_silhouette.c -- the edge adjacency and possible silhouette edges of
- * resources/silhouette.h on a closed box, a sphere, an open plane and a
+ * resources/geometry/silhouette.h on a closed box, a sphere, an open plane and a
  * non-manifold fan with a degenerate triangle: edge counts from the
  * geometry, and the silhouette's defining property (it is the boundary of the
  * triangles turned toward the light, so at every welded vertex as many edge
  * ends arrive as leave, counted with their multiplicity). ~10 ms. */
 #include <string.h>
 #include "fixtures.h"
-#include "resources/silhouette.h"
+#include "resources/geometry/silhouette.h"
 #include "test.h"
 
 #define SCENE_HEAD                                                                                         \

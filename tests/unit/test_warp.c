@@ -10,8 +10,8 @@
  * image-plane units at unit depth per map, e_x in viewport widths per map. */
 #include <string.h>
 #include "fixtures.h"
-#include "resources/aliasing.h"
-#include "resources/warp.h"
+#include "resources/analysis/aliasing.h"
+#include "resources/views/warp.h"
 #include "techniques/smap.h"
 #include "test.h"
 

@@ -12,7 +12,7 @@
 #include <string.h>
 #include "fixtures.h"
 #include "lab/compare.h"
-#include "resources/aliasing.h"
+#include "resources/analysis/aliasing.h"
 #include "techniques/smap.h"
 #include "test.h"
 

@@ -10,7 +10,7 @@
  * a run with 4 layers reuses the 2 of another and records each one's bytes. */
 #ifndef SL_PEELED_H
 #define SL_PEELED_H
-#include "resources/shadowmap.h"
+#include "resources/maps/shadowmap.h"
 
 #define PEELED_MAX_LAYERS 8
 

@@ -15,8 +15,8 @@
  * frustum, the total-aliasing storage over the samples). */
 #ifndef SL_ALIASING_H
 #define SL_ALIASING_H
-#include "resources/lightbody.h"
-#include "resources/shadowmap.h"
+#include "resources/views/lightbody.h"
+#include "resources/maps/shadowmap.h"
 
 #define ALIASING_M_CAP 1e9       /* m where J is singular (a texel seen edge-on): finite, undersampled */
 #define ALIASING_HIST_BINS 40    /* log10 m over [-2, 2] in 0.1 steps, first and last bins open */

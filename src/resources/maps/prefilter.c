@@ -1,7 +1,7 @@
 /* prefilter.c -- moment maps, box blurs, summed-area tables and min-max
  * pyramids derived from a depth map (prefilter.h; course ch.4 and its box
  * "Fast-box Filter Approximations"). */
-#include "resources/prefilter.h"
+#include "resources/maps/prefilter.h"
 #include <float.h>
 #include <math.h>
 #include <stdio.h>

@@ -1,5 +1,5 @@
 /* aliasing.c -- the sampling-error instrument (aliasing.h; course §3.1). */
-#include "resources/aliasing.h"
+#include "resources/analysis/aliasing.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

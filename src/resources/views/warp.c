@@ -3,7 +3,7 @@
  * base's NDC plane q = (x_b, y_b): the warp frame is x' = q.b, y' = q.a with
  * a the view direction's image, and the warp's body extent along a is
  * [y_min, y_min + D]. */
-#include "resources/warp.h"
+#include "resources/views/warp.h"
 #include <stdlib.h>
 #include <string.h>
 

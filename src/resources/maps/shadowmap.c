@@ -1,10 +1,10 @@
 /* shadowmap.c -- building and keying light-space depth maps (shadowmap.h). */
-#include "resources/shadowmap.h"
+#include "resources/maps/shadowmap.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/hash.h"
-#include "resources/logmap.h"
+#include "resources/maps/logmap.h"
 #include "resources/standard.h"
 
 ShadowMapSpec shadowmap_spec_default(void)

@@ -2,7 +2,7 @@
  * kept as a list of convex faces, clipped plane by plane (Sutherland-Hodgman
  * per face, the cut closed by a cap polygon), as Wimmer & Scherzer's LiSPSM
  * reference does (course §3.2.1 cites it for the construction). */
-#include "resources/lightbody.h"
+#include "resources/views/lightbody.h"
 
 #define MAX_VERTS 32 /* per face: 4, plus one per clipping plane at most */
 #define MAX_FACES 24 /* 6, plus one cap per clipping plane */

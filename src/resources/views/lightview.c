@@ -4,11 +4,11 @@
  * intersection body B (lightbody.h); the warps of §3.2.2 on top (warp.h);
  * z-partitioning into cascades (§3.2.3.1), one face per slice; texel-snapped
  * stabilisation of uniform maps. Lookups are in lightview_lookup.c. */
-#include "resources/lightview.h"
+#include "resources/views/lightview.h"
 #include <float.h>
 #include <stdlib.h>
 #include <string.h>
-#include "resources/warp.h"
+#include "resources/views/warp.h"
 
 #define MAX_TAN_PERSPECTIVE 3.7320508 /* tan 75 degrees: a 150-degree frustum at most */
 #define NEAR_MIN_FRACTION 1e-4        /* near >= this fraction of far */

@@ -9,7 +9,7 @@
 #ifndef SL_SHADOWMAP_H
 #define SL_SHADOWMAP_H
 #include "core/counters.h"
-#include "resources/lightview.h"
+#include "resources/views/lightview.h"
 #include "resources/resources.h"
 
 /* Maps above this many bytes are refused with the size, never attempted. */

@@ -2,9 +2,9 @@
  * holds what the rasterizer would store for a caster covering its centre:
  * the linear depth along the light of the nearest hit, or the base's z_ndc
  * of it; +INFINITY where the ray meets no caster. */
-#include "resources/logmap.h"
+#include "resources/maps/logmap.h"
 #include <stdlib.h>
-#include "resources/warp.h"
+#include "resources/views/warp.h"
 
 const char *logmap_refusal(const ShadowMapSpec *spec)
 {

@@ -21,7 +21,7 @@
  * e^(x - x_max) with x_max the face's largest value, so nothing overflows. */
 #ifndef SL_PREFILTER_H
 #define SL_PREFILTER_H
-#include "resources/shadowmap.h"
+#include "resources/maps/shadowmap.h"
 
 #define PREFILTER_MAX_K 63         /* the widest window, texels (pcf's K) */
 #define PREFILTER_PAD (PREFILTER_MAX_K / 2 + 3) /* texels of edge replication around each face */

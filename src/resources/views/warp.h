@@ -8,8 +8,8 @@
  * Used by lightview.c; the formulas cite their papers next to them. */
 #ifndef SL_WARP_H
 #define SL_WARP_H
-#include "resources/lightbody.h"
-#include "resources/lightview.h"
+#include "resources/views/lightbody.h"
+#include "resources/views/lightview.h"
 
 typedef struct WarpSetup {
     MapProjection kind;             /* MAP_PROJ_ORTHO (uniform, fitted in the warp's frame), PSM, LISPSM, TSM, LOGPSM */

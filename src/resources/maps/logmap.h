@@ -5,7 +5,7 @@
  * centre -> base NDC -> the light's ray -> the nearest caster on it. */
 #ifndef SL_LOGMAP_H
 #define SL_LOGMAP_H
-#include "resources/shadowmap.h"
+#include "resources/maps/shadowmap.h"
 #include "rt/rt.h"
 
 /* Fill m->depth (and m->triangle) of every face of m->view from the casters. */

@@ -1,6 +1,6 @@
 /* shadowwidth.c -- building the shadow-width map (shadowwidth.h; seed 003 §4,
  * "Generating Shadow Widths"). */
-#include "resources/shadowwidth.h"
+#include "resources/maps/shadowwidth.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

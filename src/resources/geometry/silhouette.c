@@ -3,7 +3,7 @@
  * table, edges a counting sort by their lower vertex, so the build is linear
  * in the triangles (a sphere: 26 ns per triangle at 1k triangles, 36 at 100k,
  * 120 at 1M, where the welding table's probes miss the cache). */
-#include "resources/silhouette.h"
+#include "resources/geometry/silhouette.h"
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>

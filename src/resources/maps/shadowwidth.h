@@ -16,7 +16,7 @@
  * (ShadowMap.key), so sweeps of the attenuation's constants reuse it. */
 #ifndef SL_SHADOWWIDTH_H
 #define SL_SHADOWWIDTH_H
-#include "resources/shadowmap.h"
+#include "resources/maps/shadowmap.h"
 
 typedef enum SwPropagation {
     SW_SOFTWARE4, /* in-place sweeps over the left, right, bottom and top neighbours */

@@ -3,10 +3,10 @@
  * depth or by projection, course §3.2.3.1), its texel coordinates through
  * the face's projection or warp, the ray through a texel, a texel's world
  * size and the NDC depth slope (for biases). */
-#include "resources/lightview.h"
+#include "resources/views/lightview.h"
 #include <string.h>
 #include "core/hash.h"
-#include "resources/warp.h"
+#include "resources/views/warp.h"
 
 #define SELECT_MARGIN_TEXELS 8.0 /* selection by projection: a filter's footprint stays inside the map */
 

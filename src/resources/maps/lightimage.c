@@ -1,5 +1,5 @@
 /* lightimage.c -- summed-area tables of an emission image (lightimage.h). */
-#include "resources/lightimage.h"
+#include "resources/maps/lightimage.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
