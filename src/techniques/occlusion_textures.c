@@ -39,8 +39,10 @@
  * in front holds one is NaN (the counts are integers: no NaN spreads to the
  * windows after it, as it would through a float SAT). The slices' depth
  * range is the finite depths'. */
+#include <stdio.h>
 #include <stdlib.h>
 #include "core/counters.h"
+#include "core/hash.h"
 #include "techniques/backproject.h"
 
 enum { P_SLICES = SMAP_NUM_PARAMS, P_FILTER };
@@ -67,7 +69,7 @@ static const ParamDesc ot_params[] = {
      filter_names},
 };
 
-static const char *const ot_resources[] = {"shadow_map", "minmax_pyramid", "view_samples", NULL};
+static const char *const ot_resources[] = {"shadow_map", "minmax_pyramid", "occlusion_tables", "view_samples", NULL};
 
 typedef struct OtFace {
     double z0, thick; /* slice k holds depths [z0 + k thick, z0 + (k + 1) thick), the last also z0 + S thick */
@@ -75,10 +77,12 @@ typedef struct OtFace {
 
 #define OT_MAX_LEVELS 16 /* levels of a map_size <= 16384 pyramid or N-buffer: log2(16384) + 1 = 15 */
 
-typedef struct OtState {
-    SoftMap sm;
-    SmapBias bias;
-    int slices, filter;
+/* The slice tables of a map's faces: a keyed resource (resources.h) of the
+ * map, the slice count and the filter, so a second run that changes only
+ * the bias or the light reuses them. */
+typedef struct OtTables {
+    uint64_t key;
+    int res, num_faces, slices, filter;
     int stride;          /* map_size + 1: a SAT row */
     int tables;          /* SATs per face: table 0 counts the NaN texels, tables 1 .. S slice k - 1's (filter sat) */
     OtFace face[LIGHTVIEW_MAX_FACES];
@@ -89,44 +93,92 @@ typedef struct OtState {
     int levels, level_res[OT_MAX_LEVELS];
     size_t level_at[OT_MAX_LEVELS], slice_floats;
     float *level;        /* [(face * slices + k) * slice_floats + level_at[l] + j * level_res[l] + i] */
+} OtTables;
+
+typedef struct OtState {
+    SoftMap sm;
+    SmapBias bias;
+    const OtTables *tab; /* owned by the resource manager */
 } OtState;
 
-static uint32_t *sat_of(const OtState *st, int face, int table)
+static uint32_t *sat_of(const OtTables *t, int face, int table)
 {
-    return st->sat + ((size_t)face * st->tables + table) * (size_t)st->stride * st->stride;
+    return t->sat + ((size_t)face * t->tables + table) * (size_t)t->stride * t->stride;
 }
 
-static float *level_of(const OtState *st, int face, int k, int l)
+static float *level_of(const OtTables *t, int face, int k, int l)
 {
-    return st->level + ((size_t)face * st->slices + k) * st->slice_floats + st->level_at[l];
+    return t->level + ((size_t)face * t->slices + k) * t->slice_floats + t->level_at[l];
 }
 
 /* The level layout of the filter: an N-buffer has a full-resolution level
  * per power of two up to map_size, a mipmap halves (rounding up) down to 1. */
-static void level_layout(OtState *st, int res)
+static void level_layout(OtTables *tab, int res)
 {
-    st->levels = 0;
-    st->slice_floats = 0;
-    if (st->filter == FILTER_SAT) return;
+    tab->levels = 0;
+    tab->slice_floats = 0;
+    if (tab->filter == FILTER_SAT) return;
     for (int l = 0, n = res; l < OT_MAX_LEVELS; l++) {
-        bool nbuffer = st->filter == FILTER_NBUFFER;
-        if (nbuffer ? (1 << l) > res : (l > 0 && st->level_res[l - 1] == 1)) break;
-        st->level_res[l] = nbuffer ? res : n;
-        st->level_at[l] = st->slice_floats;
-        st->slice_floats += (size_t)st->level_res[l] * st->level_res[l];
-        st->levels = l + 1;
+        bool nbuffer = tab->filter == FILTER_NBUFFER;
+        if (nbuffer ? (1 << l) > res : (l > 0 && tab->level_res[l - 1] == 1)) break;
+        tab->level_res[l] = nbuffer ? res : n;
+        tab->level_at[l] = tab->slice_floats;
+        tab->slice_floats += (size_t)tab->level_res[l] * tab->level_res[l];
+        tab->levels = l + 1;
         n = (n + 1) / 2;
     }
 }
 
+/* The tables' shape (everything but their contents) for a map, S and filter. */
+static void tables_layout(OtTables *t, const ShadowMap *map, int slices, int filter)
+{
+    *t = (OtTables){.res = map->res, .num_faces = map->num_faces, .slices = slices, .filter = filter};
+    t->stride = map->res + 1;
+    t->tables = 1 + (filter == FILTER_SAT ? slices : 0);
+    level_layout(t, map->res);
+}
+
+static size_t tables_sats(const OtTables *t) { return (size_t)t->num_faces * t->tables * t->stride * t->stride; }
+static size_t tables_floats(const OtTables *t) { return (size_t)t->num_faces * t->slices * t->slice_floats; }
+
+/* Bytes of the tables' arrays (a double, for the size check and its message). */
+static double tables_array_bytes(const OtTables *t)
+{
+    return (double)tables_sats(t) * sizeof(uint32_t) + (double)tables_floats(t) * sizeof(float);
+}
+
+static size_t tables_bytes(const void *res)
+{
+    const OtTables *t = res;
+    return sizeof *t + tables_sats(t) * sizeof(uint32_t) + tables_floats(t) * sizeof(float);
+}
+
+static void tables_destroy(void *res)
+{
+    OtTables *t = res;
+    if (t) {
+        free(t->sat);
+        free(t->level);
+    }
+    free(t);
+}
+
+static const ResourceKind kind_tables = {"occlusion_tables", tables_bytes, tables_destroy, RES_FRAME};
+
+/* Linear depth of texel (i, j) (softmap_depth without a SoftMap). */
+static double map_depth(const ShadowMap *map, int face, int i, int j)
+{
+    return smap_linear_depth(map, face, shadowmap_texel(map, face, i, j));
+}
+
 /* The depth range of a face's casters (world units), [+INF, -INF] when empty. */
-static void face_range(const SoftMap *sm, int face, double *lo, double *hi)
+static void face_range(const ShadowMap *map, int face, double *lo, double *hi)
 {
     *lo = INFINITY;
     *hi = -INFINITY;
-    for (int j = 0; j < sm->map->res; j++)
-        for (int i = 0; i < sm->map->res; i++) {
-            double d = softmap_depth(sm, face, i, j);
+    for (int j = 0; j < map->res; j++)
+        for (int i = 0; i < map->res; i++) {
+            double d = map_depth(map, face, i, j);
             if (!isfinite(d)) continue;
             if (d < *lo) *lo = d;
             if (d > *hi) *hi = d;
@@ -162,16 +214,16 @@ static int clamp_index(int i, int n) { return i < n ? i : n - 1; }
 /* Slice k's levels from its occupancy: N-buffer level l the mean of the four
  * level l - 1 blocks at offsets 0 and 2^(l-1) (edge-clamped, Décoret 2005);
  * mipmap level l the mean of the 2x2 children (edge-clamped). */
-static void build_levels(const OtState *st, int face, int k, const uint8_t *slice)
+static void build_levels(const OtTables *tab, int face, int k, const uint8_t *slice)
 {
-    int res = st->level_res[0];
-    float *l0 = level_of(st, face, k, 0);
+    int res = tab->level_res[0];
+    float *l0 = level_of(tab, face, k, 0);
     for (size_t t = 0; t < (size_t)res * res; t++) l0[t] = slice[t] == k ? 1.0f : 0.0f;
-    for (int l = 1; l < st->levels; l++) {
-        const float *a = level_of(st, face, k, l - 1);
-        float *b = level_of(st, face, k, l);
-        int na = st->level_res[l - 1], nb = st->level_res[l];
-        bool nbuffer = st->filter == FILTER_NBUFFER;
+    for (int l = 1; l < tab->levels; l++) {
+        const float *a = level_of(tab, face, k, l - 1);
+        float *b = level_of(tab, face, k, l);
+        int na = tab->level_res[l - 1], nb = tab->level_res[l];
+        bool nbuffer = tab->filter == FILTER_NBUFFER;
         int h = nbuffer ? 1 << (l - 1) : 1;
         for (int j = 0; j < nb; j++)
             for (int i = 0; i < nb; i++) {
@@ -186,38 +238,93 @@ static void build_levels(const OtState *st, int face, int k, const uint8_t *slic
 }
 
 /* Each texel's slice, then the NaN counts' SAT and the filter's tables. */
-static bool build_face(OtState *st, int face)
+static bool build_face(OtTables *tab, const ShadowMap *map, int face)
 {
-    OtFace *f = &st->face[face];
+    OtFace *f = &tab->face[face];
     double lo, hi;
-    face_range(&st->sm, face, &lo, &hi);
+    face_range(map, face, &lo, &hi);
     f->z0 = isfinite(lo) ? lo : 0.0;
-    f->thick = isfinite(lo) ? (hi - lo) / st->slices : 0.0;
-    int res = st->sm.map->res;
+    f->thick = isfinite(lo) ? (hi - lo) / tab->slices : 0.0;
+    int res = map->res;
     uint8_t *slice = malloc((size_t)res * res);
     if (!slice) return false;
     for (int j = 0; j < res; j++)
         for (int i = 0; i < res; i++) {
-            double d = softmap_depth(&st->sm, face, i, j);
+            double d = map_depth(map, face, i, j);
             slice[(size_t)j * res + i] =
-                isnan(d) ? (uint8_t)st->slices : isfinite(d) ? (uint8_t)slice_of(f, st->slices, d) : OT_EMPTY;
+                isnan(d) ? (uint8_t)tab->slices : isfinite(d) ? (uint8_t)slice_of(f, tab->slices, d) : OT_EMPTY;
         }
-    build_sat(sat_of(st, face, 0), slice, res, st->slices);
-    for (int t = 1; t < st->tables; t++) build_sat(sat_of(st, face, t), slice, res, t - 1);
-    for (int k = 0; k < st->slices && st->levels > 0; k++) build_levels(st, face, k, slice);
+    build_sat(sat_of(tab, face, 0), slice, res, tab->slices);
+    for (int t = 1; t < tab->tables; t++) build_sat(sat_of(tab, face, t), slice, res, t - 1);
+    for (int k = 0; k < tab->slices && tab->levels > 0; k++) build_levels(tab, face, k, slice);
     free(slice);
     return true;
 }
 
-static void ot_release(void *state)
+typedef struct TablesArgs {
+    const ShadowMap *map;
+    const OtTables *shape; /* tables_layout's, size-checked */
+    uint64_t key;
+} TablesArgs;
+
+static void *build_tables(const void *args, Error *err)
 {
-    OtState *st = state;
-    if (st) {
-        free(st->sat);
-        free(st->level);
+    const TablesArgs *a = args;
+    OtTables *t = malloc(sizeof *t);
+    if (!t) {
+        error_set(err, "out of memory");
+        return NULL;
     }
-    free(st);
+    *t = *a->shape;
+    t->key = a->key;
+    size_t floats = tables_floats(t);
+    t->sat = calloc(tables_sats(t), sizeof *t->sat);
+    t->level = floats ? malloc(floats * sizeof *t->level) : NULL;
+    if (!t->sat || (floats && !t->level)) {
+        error_set(err, "occlusion_textures: out of memory for %.2f GiB of slice tables",
+                  tables_array_bytes(t) / (1u << 30));
+        tables_destroy(t);
+        return NULL;
+    }
+    for (int f = 0; f < t->num_faces; f++)
+        if (!build_face(t, a->map, f)) {
+            error_set(err, "occlusion_textures: out of memory for a %d^2 slice index", t->res);
+            tables_destroy(t);
+            return NULL;
+        }
+    return t;
 }
+
+/* The slice tables of the map at S and filter: keyed by exactly those (the
+ * faces' depth ranges are the map's), refused above SHADOWMAP_MAX_BYTES
+ * before anything is allocated. */
+static const OtTables *res_tables(ResourceManager *rm, const ShadowMap *map, int slices, int filter, Error *err)
+{
+    OtTables shape;
+    tables_layout(&shape, map, slices, filter);
+    double bytes = tables_array_bytes(&shape), gib = bytes / (1u << 30);
+    if (bytes > (double)SHADOWMAP_MAX_BYTES) {
+        error_set(err, "occlusion_textures: slices = %d, filter = %s of map_size = %d (%d faces) take %.2f GiB, "
+                       "above the %.0f GiB limit: lower slices or map_size, or filter=sat",
+                  slices, filter_names[filter], map->res, map->num_faces, gib,
+                  (double)SHADOWMAP_MAX_BYTES / (1u << 30));
+        return NULL;
+    }
+    Hasher h;
+    hash_init(&h);
+    hash_u64(&h, map->key);
+    hash_str(&h, "occlusion tables");
+    hash_u64(&h, (uint64_t)slices);
+    hash_u64(&h, (uint64_t)filter);
+    TablesArgs a = {map, &shape, hash_final(&h)};
+    char desc[160], mk[17];
+    hash_hex(map->key, mk);
+    snprintf(desc, sizeof desc, "%d slices, %s, of map %s (%d x %d^2)", slices, filter_names[filter], mk,
+             map->num_faces, map->res);
+    return rm_acquire(rm, &kind_tables, a.key, desc, build_tables, &a, err);
+}
+
+static void ot_release(void *state) { free(state); }
 
 static bool ot_prepare(const TechContext *ctx, void **state, Error *err)
 {
@@ -226,46 +333,21 @@ static bool ot_prepare(const TechContext *ctx, void **state, Error *err)
     if (!st) return error_set(err, "out of memory");
     ShadowMapSpec spec = smap_spec(p);
     const ShadowMap *map = res_shadow_map(ctx->rm, ctx->scene, ctx->light_index, &spec, err);
-    if (!map || !softmap_init(&st->sm, ctx->rm, map, ctx->light, "occlusion_textures", err)) {
+    if (!map || !softmap_init(&st->sm, ctx->rm, map, ctx->light, "occlusion_textures", err) ||
+        !(st->tab = res_tables(ctx->rm, map, (int)p[P_SLICES], (int)p[P_FILTER], err))) {
         free(st);
         return false;
     }
     st->bias = smap_bias(p, ctx->scene);
-    st->slices = (int)p[P_SLICES];
-    st->filter = (int)p[P_FILTER];
-    st->stride = map->res + 1;
-    st->tables = 1 + (st->filter == FILTER_SAT ? st->slices : 0);
-    level_layout(st, map->res);
-    size_t sats = (size_t)map->num_faces * st->tables * st->stride * st->stride;
-    size_t floats = (size_t)map->num_faces * st->slices * st->slice_floats;
-    double bytes = (double)sats * sizeof(uint32_t) + (double)floats * sizeof(float), gib = bytes / (1u << 30);
-    if (bytes > (double)SHADOWMAP_MAX_BYTES) {
-        free(st);
-        return error_set(err, "occlusion_textures: slices = %d, filter = %s of map_size = %d (%d faces) take %.2f GiB, "
-                              "above the %.0f GiB limit: lower slices or map_size, or filter=sat",
-                         (int)p[P_SLICES], filter_names[(int)p[P_FILTER]], map->res, map->num_faces, gib,
-                         (double)SHADOWMAP_MAX_BYTES / (1u << 30));
-    }
-    st->sat = calloc(sats, sizeof *st->sat);
-    st->level = floats ? malloc(floats * sizeof *st->level) : NULL;
-    if (!st->sat || (floats && !st->level)) {
-        ot_release(st);
-        return error_set(err, "occlusion_textures: out of memory for %.2f GiB of slice tables", gib);
-    }
-    for (int f = 0; f < map->num_faces; f++)
-        if (!build_face(st, f)) {
-            ot_release(st);
-            return error_set(err, "occlusion_textures: out of memory for a %d^2 slice index", map->res);
-        }
     *state = st;
     return true;
 }
 
 /* The mean of table t's texels over [i0, i1] x [j0, j1] (inside the face). */
-static double sat_mean(const OtState *st, int face, int t, int i0, int j0, int i1, int j1)
+static double sat_mean(const OtTables *tab, int face, int t, int i0, int j0, int i1, int j1)
 {
-    int n = st->stride;
-    const uint32_t *s = sat_of(st, face, t);
+    int n = tab->stride;
+    const uint32_t *s = sat_of(tab, face, t);
     work_texels(4, sizeof *s); /* the SAT's four corners (core/counters.h) */
     double count = (double)s[(size_t)(j1 + 1) * n + i1 + 1] - s[(size_t)j0 * n + i1 + 1] - s[(size_t)(j1 + 1) * n + i0] +
                    s[(size_t)j0 * n + i0];
@@ -284,11 +366,11 @@ static int spread(int lo, int hi, int a, int n) { return n == 1 ? lo : lo + (int
 
 /* The N-buffer estimate: the mean of the level-l blocks (2^l <= the window's
  * narrower side) at ceil(K / 2^l) starts per axis. */
-static double nbuffer_mean(const OtState *st, int face, int k, int i0, int j0, int i1, int j1)
+static double nbuffer_mean(const OtTables *tab, int face, int k, int i0, int j0, int i1, int j1)
 {
     int kx = i1 - i0 + 1, ky = j1 - j0 + 1, l = floor_log2(kx < ky ? kx : ky), b = 1 << l;
-    int nx = (kx + b - 1) / b, ny = (ky + b - 1) / b, res = st->level_res[l];
-    const float *lv = level_of(st, face, k, l);
+    int nx = (kx + b - 1) / b, ny = (ky + b - 1) / b, res = tab->level_res[l];
+    const float *lv = level_of(tab, face, k, l);
     work_texels(nx * ny, sizeof *lv); /* one read per block */
     double sum = 0.0;
     for (int y = 0; y < ny; y++)
@@ -299,19 +381,19 @@ static double nbuffer_mean(const OtState *st, int face, int k, int i0, int j0, i
 
 /* The mipmap estimate: bilinear at the window's centre on the level nearest
  * log2 of its narrower side. */
-static double mipmap_mean(const OtState *st, int face, int k, int i0, int j0, int i1, int j1)
+static double mipmap_mean(const OtTables *tab, int face, int k, int i0, int j0, int i1, int j1)
 {
     int kx = i1 - i0 + 1, ky = j1 - j0 + 1;
     int l = (int)floor(log2((double)(kx < ky ? kx : ky)) + 0.5);
-    l = l < st->levels ? l : st->levels - 1;
-    int n = st->level_res[l];
+    l = l < tab->levels ? l : tab->levels - 1;
+    int n = tab->level_res[l];
     double scale = ldexp(1.0, -l);
     double u = 0.5 * (i0 + i1 + 1) * scale - 0.5, v = 0.5 * (j0 + j1 + 1) * scale - 0.5; /* level-l texel centres */
     int x0 = (int)floor(u), y0 = (int)floor(v);
     double fx = u - x0, fy = v - y0;
     int xa = x0 < 0 ? 0 : clamp_index(x0, n), xb = clamp_index(x0 + 1 < 0 ? 0 : x0 + 1, n);
     int ya = y0 < 0 ? 0 : clamp_index(y0, n), yb = clamp_index(y0 + 1 < 0 ? 0 : y0 + 1, n);
-    const float *lv = level_of(st, face, k, l);
+    const float *lv = level_of(tab, face, k, l);
     work_texels(4, sizeof *lv); /* the bilinear footprint */
     double top = (1 - fx) * lv[(size_t)ya * n + xa] + fx * lv[(size_t)ya * n + xb];
     double bottom = (1 - fx) * lv[(size_t)yb * n + xa] + fx * lv[(size_t)yb * n + xb];
@@ -319,20 +401,20 @@ static double mipmap_mean(const OtState *st, int face, int k, int i0, int j0, in
 }
 
 /* Slice k's occupancy mean (k = -1: the NaN texels') over texels
- * [i0, i1] x [j0, j1], clamped to the face, by the state's filter. */
-static double box_mean(const OtState *st, int face, int k, int i0, int j0, int i1, int j1)
+ * [i0, i1] x [j0, j1], clamped to the face, by the tables' filter. */
+static double box_mean(const OtTables *tab, int face, int k, int i0, int j0, int i1, int j1)
 {
-    int res = st->sm.map->res;
+    int res = tab->res;
     i0 = i0 < 0 ? 0 : i0;
     j0 = j0 < 0 ? 0 : j0;
     i1 = i1 >= res ? res - 1 : i1;
     j1 = j1 >= res ? res - 1 : j1;
     if (i0 > i1 || j0 > j1) return 0.0; /* off the face: nothing known to occlude */
-    if (k < 0) return sat_mean(st, face, 0, i0, j0, i1, j1);
-    switch (st->filter) {
-    case FILTER_SAT: return sat_mean(st, face, 1 + k, i0, j0, i1, j1);
-    case FILTER_NBUFFER: return nbuffer_mean(st, face, k, i0, j0, i1, j1);
-    default: return mipmap_mean(st, face, k, i0, j0, i1, j1);
+    if (k < 0) return sat_mean(tab, face, 0, i0, j0, i1, j1);
+    switch (tab->filter) {
+    case FILTER_SAT: return sat_mean(tab, face, 1 + k, i0, j0, i1, j1);
+    case FILTER_NBUFFER: return nbuffer_mean(tab, face, k, i0, j0, i1, j1);
+    default: return mipmap_mean(tab, face, k, i0, j0, i1, j1);
     }
 }
 
@@ -350,22 +432,23 @@ static void window(double c, double half_texels, int *lo, int *hi)
  * unless the known casters already make it 0 (a caster only lowers it). */
 static float visibility(const OtState *st, const SmapReceiver *r)
 {
+    const OtTables *tab = st->tab;
     int face = r->mc.face, i, j;
-    const OtFace *f = &st->face[face];
+    const OtFace *f = &tab->face[face];
     const SoftFace *sf = &st->sm.face[face];
     smap_texel(r, &i, &j);
     double p_z = smap_linear_depth(st->sm.map, face, smap_ref_at(r, i, j)), r_z = r->mc.depth_linear;
     if (isnan(p_z)) return NAN; /* which slices lie in front is unknown */
     double v = 1.0;
     bool unknown = false;
-    for (int k = 0; k < st->slices; k++) {
+    for (int k = 0; k < tab->slices; k++) {
         double bottom = f->z0 + (k + 1) * f->thick; /* the plane the slice is projected onto */
         if (!(bottom < p_z)) break;                 /* NaN: no slice known to lie in front */
         int i0, i1, j0, j1;
         window(r->mc.s, backproject_footprint(sf->light.half_x, r_z, bottom) / sf->dx, &i0, &i1);
         window(r->mc.t, backproject_footprint(sf->light.half_y, r_z, bottom) / sf->dy, &j0, &j1);
-        unknown = unknown || box_mean(st, face, -1, i0, j0, i1, j1) > 0.0; /* a caster of unknown slice */
-        v *= 1.0 - box_mean(st, face, k, i0, j0, i1, j1);
+        unknown = unknown || box_mean(tab, face, -1, i0, j0, i1, j1) > 0.0; /* a caster of unknown slice */
+        v *= 1.0 - box_mean(tab, face, k, i0, j0, i1, j1);
     }
     return unknown && v > 0.0 ? NAN : (float)v;
 }

@@ -10,6 +10,7 @@
  * leaks, no overlaps). 160 x 120 or smaller. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 #include "fixtures.h"
 #include "resources/standard.h"
 #include "soft_helpers.h"
@@ -527,6 +528,44 @@ TEST(test_occlusion_textures_one_slice_and_one_plane_stay_finite)
         render_result_free(&r);
         lab_close(planes[k]);
     }
+}
+
+/* The render's occlusion_tables event (NULL: none). */
+static const ResourceEvent *tables_event(const RenderResult *r)
+{
+    for (int i = 0; i < r->num_tech_resources; i++)
+        if (strcmp(r->tech_resources[i].kind, "occlusion_tables") == 0) return &r->tech_resources[i];
+    return NULL;
+}
+
+/* The slice tables are a keyed resource of the map, S and the filter: a
+ * second render at another bias reuses them, one at another S builds them
+ * anew, and their bytes (filter=sat: a NaN-count SAT and S slice SATs of
+ * (map_size + 1)^2 uint32 per face, plus the header) are logged and in the
+ * frame's bytes. */
+TEST(test_occlusion_textures_tables_are_a_keyed_resource)
+{
+    Lab *lab = soft_open("sphere-on-plane.lua", NULL);
+    CHECK(lab);
+    static const struct { const char *slices, *bias; bool built; } runs[] = {
+        {"slices=4", "bias=0", true}, {"slices=4", "bias=0.01", false}, {"slices=5", "bias=0.01", true}};
+    for (int k = 0; k < 3; k++) {
+        const char *p[] = {"map_size=256", "filter=sat", runs[k].slices, runs[k].bias, NULL};
+        RenderResult r;
+        CHECK(soft_render(lab, "occlusion_textures", p, &r));
+        const ResourceEvent *ev = tables_event(&r);
+        CHECK_MSG(ev, "%s %s: no occlusion_tables in the resource log", runs[k].slices, runs[k].bias);
+        size_t per_face = (size_t)(1 + (k < 2 ? 4 : 5)) * 257 * 257 * sizeof(uint32_t);
+        size_t faces = ev->bytes / per_face;
+        printf("    %s, %s: occlusion_tables %s, %zu bytes (%zu faces), frame bytes %zu\n", runs[k].slices,
+               runs[k].bias, ev->built ? "built" : "reused", ev->bytes, faces, r.frame_bytes);
+        CHECK_MSG(ev->built == runs[k].built, "%s %s: tables %s", runs[k].slices, runs[k].bias,
+                  ev->built ? "built again" : "reused across slices");
+        CHECK(faces >= 1 && faces <= 6 && ev->bytes - faces * per_face < 4096);
+        CHECK(r.frame_bytes >= ev->bytes);
+        render_result_free(&r);
+    }
+    lab_close(lab);
 }
 
 /* The occlusion a technique's visibility keeps of the reference's, over the
