@@ -23,9 +23,11 @@
  * slope) split into layers of a few counts each, and receivers match none
  * (umbra everywhere); too large, occluder and receiver merge into one entry
  * counting every sample (lit everywhere). test_multimap measures both. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "core/counters.h"
+#include "core/hash.h"
 #include "rt/rt.h"
 #include "techniques/multimap.h"
 
@@ -55,10 +57,12 @@ static const ParamDesc la_params[] = {
      NULL},
 };
 
-static const char *const la_resources[] = {"shadow_map", "view_samples", NULL};
+static const char *const la_resources[] = {"shadow_map", "layered_attenuation_ldi", "view_samples", NULL};
 static const char *const la_aux[] = {"layers", "overflow", NULL};
 
-/* The layered depth image on the centre map's grid (faces x res^2 texels). */
+/* The layered depth image on the centre map's grid (faces x res^2 texels):
+ * a keyed frame resource (resources.h), so it is in the run's log and frame
+ * bytes and is reused while its inputs stay. */
 typedef struct Ldi {
     const LightView *view; /* the centre's */
     int cap;               /* layers per texel */
@@ -75,17 +79,20 @@ typedef struct LaState {
     int n;
     double epsilon;
     float scene_extent;
-    Ldi ldi;
+    const Ldi *ldi; /* owned by the resource manager */
 } LaState;
 
-static void ldi_free(Ldi *l)
+static void ldi_free(void *res)
 {
+    Ldi *l = res;
+    if (!l) return;
     free(l->used);
     free(l->unknown);
     free(l->overflow);
     free(l->depth);
     free(l->count);
     free(l->last);
+    free(l);
 }
 
 /* Bytes of an LDI of `texels` texels and `cap` layers: per texel its layer
@@ -106,9 +113,22 @@ static bool ldi_check(size_t texels, int cap, int res, Error *err)
                      cap, res, bytes / (1u << 30), (double)SHADOWMAP_MAX_BYTES / (1u << 30));
 }
 
-static bool ldi_alloc(Ldi *l, const LightView *view, int cap, Error *err)
+static size_t ldi_resource_bytes(const void *res)
+{
+    const Ldi *l = res;
+    return sizeof *l + (size_t)ldi_bytes(l->texels, l->cap);
+}
+
+static const ResourceKind kind_ldi = {"layered_attenuation_ldi", ldi_resource_bytes, ldi_free, RES_FRAME};
+
+static Ldi *ldi_alloc(const LightView *view, int cap, Error *err)
 {
     size_t texels = (size_t)view->num_faces * (size_t)view->res * (size_t)view->res;
+    Ldi *l = calloc(1, sizeof *l);
+    if (!l) {
+        error_set(err, "out of memory");
+        return NULL;
+    }
     *l = (Ldi){.view = view, .cap = cap, .texels = texels};
     l->used = calloc(texels, 1);
     l->unknown = calloc(texels, 1);
@@ -116,11 +136,10 @@ static bool ldi_alloc(Ldi *l, const LightView *view, int cap, Error *err)
     l->depth = malloc(texels * (size_t)cap * sizeof *l->depth);
     l->count = malloc(texels * (size_t)cap * sizeof *l->count);
     l->last = malloc(texels * (size_t)cap * sizeof *l->last);
-    if (l->used && l->unknown && l->overflow && l->depth && l->count && l->last) return true;
+    if (l->used && l->unknown && l->overflow && l->depth && l->count && l->last) return l;
     ldi_free(l);
-    *l = (Ldi){0};
-    return error_set(err, "out of memory for the LDI (%.2f GiB)",
-                     ldi_bytes(texels, cap) / (1u << 30));
+    error_set(err, "out of memory for the LDI (%.2f GiB)", ldi_bytes(texels, cap) / (1u << 30));
+    return NULL;
 }
 
 /* The entry of texel `t` nearest depth z within epsilon, or -1. */
@@ -273,7 +292,8 @@ static int warp_row(const Ldi *l, const ShadowMap *m, int f, int j, Warped *out)
 
 /* Warp sample k's map into the LDI, row by row in order (serial: the
  * layers' order is the samples' and the rows', whatever the thread count;
- * an omp-ordered loop ran 18x slower on a loaded machine). */
+ * an omp-ordered loop ran 18x slower on a loaded machine). The row's warped
+ * points are build scratch, freed before it returns. */
 static bool ldi_warp(Ldi *l, const ShadowMap *m, int k, double epsilon)
 {
     Warped *buf = malloc((size_t)m->res * LA_WARP_SUB * LA_WARP_SUB * sizeof *buf);
@@ -287,6 +307,45 @@ static bool ldi_warp(Ldi *l, const ShadowMap *m, int k, double epsilon)
         }
     free(buf);
     return true;
+}
+
+typedef struct LdiArgs {
+    const ShadowMap *centre;
+    const ShadowMap *const *map; /* the n samples' */
+    int n, cap;
+    double epsilon;
+} LdiArgs;
+
+static void *build_ldi(const void *args, Error *err)
+{
+    const LdiArgs *a = args;
+    Ldi *l = ldi_alloc(&a->centre->view, a->cap, err);
+    for (int k = 0; l && k < a->n; k++)
+        if (!ldi_warp(l, a->map[k], k, a->epsilon)) {
+            ldi_free(l);
+            l = NULL;
+            error_set(err, "out of memory");
+        }
+    return l;
+}
+
+/* The LDI, keyed by exactly what build_ldi reads: the centre's map (its
+ * grid), the samples' maps in order, the layer cap and epsilon. */
+static const Ldi *res_ldi(ResourceManager *rm, const LdiArgs *a, Error *err)
+{
+    Hasher h;
+    hash_init(&h);
+    hash_str(&h, kind_ldi.name);
+    hash_u64(&h, a->centre->key);
+    hash_u64(&h, (uint64_t)a->n);
+    for (int k = 0; k < a->n; k++) hash_u64(&h, a->map[k]->key);
+    hash_u64(&h, (uint64_t)a->cap);
+    hash_f64(&h, a->epsilon);
+    char desc[160], mk[17];
+    hash_hex(a->centre->key, mk);
+    snprintf(desc, sizeof desc, "LDI on map %s (%d x %d^2) of %d samples' maps, %d layers, epsilon %.6g", mk,
+             a->centre->num_faces, a->centre->res, a->n, a->cap, a->epsilon);
+    return rm_acquire(rm, &kind_ldi, hash_final(&h), desc, build_ldi, a, err);
 }
 
 static bool la_prepare(const TechContext *ctx, void **state, Error *err)
@@ -305,17 +364,14 @@ static bool la_prepare(const TechContext *ctx, void **state, Error *err)
     ShadowMapSpec spec = smap_spec(p);
     Light probe = {.kind = LIGHT_POINT, .position = ctx->light->position};
     size_t most_texels = shadowmap_bytes_for(&probe, &spec) / sizeof(float);
-    const ShadowMap *centre = NULL;
-    bool ok = ldi_check(most_texels, (int)p[P_LAYERS], spec.res, err) &&
+    LdiArgs a = {NULL, map, st->n, (int)p[P_LAYERS], st->epsilon};
+    bool ok = ldi_check(most_texels, a.cap, spec.res, err) &&
               ls_sample_maps(ctx, &spec, st->n, (int)p[P_LS_PATTERN], point, map, err) &&
-              (centre = ls_point_map(ctx, &spec, ctx->light->position, err)) &&
-              ldi_alloc(&st->ldi, &centre->view, (int)p[P_LAYERS], err);
-    for (int k = 0; ok && k < st->n; k++)
-        if (!ldi_warp(&st->ldi, map[k], k, st->epsilon)) ok = error_set(err, "out of memory");
+              (a.centre = ls_point_map(ctx, &spec, ctx->light->position, err)) &&
+              (st->ldi = res_ldi(ctx->rm, &a, err));
     free(map);
     free(point);
     if (!ok) {
-        if (st->ldi.used) ldi_free(&st->ldi);
         free(st);
         return false;
     }
@@ -323,20 +379,13 @@ static bool la_prepare(const TechContext *ctx, void **state, Error *err)
     return true;
 }
 
-static void la_release(void *state)
-{
-    LaState *st = state;
-    if (!st) return;
-    ldi_free(&st->ldi);
-    free(st);
-}
-
+static void la_release(void *state) { free(state); }
 /* V = counter / N of the entry matching the receiver's depth (lifted off
  * the surface by rt_ray_offset, as the reference's rays); lit outside the
  * centre's map, as light_sampling; NaN where a sample's NaN may land. */
 static float la_visibility(const LaState *st, vec3 p, vec3 n, float *aux)
 {
-    const Ldi *l = &st->ldi;
+    const Ldi *l = st->ldi;
     dvec3 q = d3_madd(d3_from(p), d3_from(n), rt_ray_offset(st->scene_extent, p));
     size_t t;
     double z;

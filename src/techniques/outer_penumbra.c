@@ -73,8 +73,10 @@
  * perspective frusta from the light's centre (projection auto, perspective
  * or cube: softmap_frames refuses others by name). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include "core/counters.h"
+#include "core/hash.h"
 #include "raster/segment.h"
 #include "resources/geometry/silhouette.h"
 #include "rt/outer.h"
@@ -99,7 +101,9 @@ static const ParamDesc penumbra_params[] = {
     SMAP_BIAS_PARAMS,
 };
 
-static const char *const outer_resources[] = {"shadow_map", "silhouette", "view_samples", NULL};
+static const char *const smoothie_resources[] = {"shadow_map", "silhouette", "smoothie_buffer", "view_samples", NULL};
+static const char *const penumbra_resources[] = {"shadow_map", "silhouette", "penumbra_map_buffer", "view_samples",
+                                                 NULL};
 
 /* A silhouette edge on one face: tangent coordinates of its (near-clipped)
  * ends, the reciprocal depths there, and the band's radius (tangent units). */
@@ -111,28 +115,48 @@ typedef struct FaceEdge {
 
 typedef enum OuterKind { OUTER_SMOOTHIES, OUTER_PENUMBRA_MAP } OuterKind;
 
+/* The light-space buffer: a keyed frame resource (resources.h), so it is in
+ * the run's log and frame bytes and is reused while its inputs stay. */
+typedef struct OuterBuffer {
+    size_t texels;
+    float *value;   /* per texel of every face: smoothies' alpha (1 where nothing drew), or the penumbra map's
+                       shadow intensity I (0 where nothing drew) */
+    float *depth;   /* smoothies: z_s (world units along the face's axis), +inf where nothing drew; else NULL */
+} OuterBuffer;
+
 typedef struct OuterState {
     OuterKind kind;
     SoftMap sm;     /* the hard map and its faces' frames */
     SmapBias bias;
-    float *value;   /* per texel of every face: smoothies' alpha (1 where nothing drew), or the penumbra map's
-                       shadow intensity I (0 where nothing drew) */
-    float *depth;   /* smoothies: z_s (world units along the face's axis), +inf where nothing drew; else NULL */
+    const OuterBuffer *buf; /* owned by the resource manager */
     double smoothie_width; /* t, tangent units */
     double light_radius;   /* R = D / 2, world units */
 } OuterState;
 
-static void outer_release(void *state)
-{
-    OuterState *st = state;
-    if (!st) return;
-    free(st->value);
-    free(st->depth);
-    free(st);
-}
+static void outer_release(void *state) { free(state); }
 
 /* Floats per texel of the light-space buffer: smoothies' alpha and depth, or I. */
 static int buffer_floats(OuterKind kind) { return kind == OUTER_SMOOTHIES ? 2 : 1; }
+
+static size_t buffer_bytes(const void *res)
+{
+    const OuterBuffer *b = res;
+    return sizeof *b + b->texels * sizeof(float) * (b->depth ? 2u : 1u);
+}
+
+static void buffer_free(void *res)
+{
+    OuterBuffer *b = res;
+    if (!b) return;
+    free(b->value);
+    free(b->depth);
+    free(b);
+}
+
+static const ResourceKind kind_buffer[] = {
+    [OUTER_SMOOTHIES] = {"smoothie_buffer", buffer_bytes, buffer_free, RES_FRAME},
+    [OUTER_PENUMBRA_MAP] = {"penumbra_map_buffer", buffer_bytes, buffer_free, RES_FRAME},
+};
 
 /* ---- projecting the silhouette onto a face ------------------------------ */
 
@@ -168,7 +192,7 @@ static bool project_edge(const MapFace *f, const SilEdge *e, FaceEdge *out)
 /* ---- the fragments -------------------------------------------------------- */
 
 typedef struct Draw {
-    const OuterState *st;
+    const OuterState *st; /* its buffer is the one being drawn, not yet st->buf */
     int face;
     float *value, *depth; /* this face's texels */
     const FaceEdge *edge;
@@ -210,7 +234,7 @@ static void penumbra_fragment(void *user, int i, int j, double u, double dist)
 #define BAND_ROWS 16
 
 /* One face: every edge's band, in bands of rows drawn in parallel. */
-static void draw_face(const OuterState *st, int face, const FaceEdge *edges, int n)
+static void draw_face(const OuterState *st, OuterBuffer *buf, int face, const FaceEdge *edges, int n)
 {
     const SoftFace *sf = &st->sm.face[face];
     int res = st->sm.map->res, bands = (res + BAND_ROWS - 1) / BAND_ROWS;
@@ -219,7 +243,7 @@ static void draw_face(const OuterState *st, int face, const FaceEdge *edges, int
     size_t base = texel_index(st->sm.map, face, 0, 0);
 #pragma omp parallel for schedule(dynamic, 1)
     for (int band = 0; band < bands; band++) {
-        Draw d = {st, face, st->value + base, st->depth ? st->depth + base : NULL, NULL};
+        Draw d = {st, face, buf->value + base, buf->depth ? buf->depth + base : NULL, NULL};
         int row_end = (band + 1) * BAND_ROWS < res ? (band + 1) * BAND_ROWS : res;
         for (int e = 0; e < n; e++) {
             d.edge = &edges[e];
@@ -237,21 +261,46 @@ static double band_radius(const OuterState *st, const MapFace *f, const FaceEdge
     return fmax(0.0, st->light_radius * (inv_near - 1.0 / f->raster.depth_far));
 }
 
-static bool draw_buffer(OuterState *st, const Silhouette *sil, Error *err)
+typedef struct BufferArgs {
+    const OuterState *st;
+    const Silhouette *sil;
+} BufferArgs;
+
+/* Allocates the buffer with every texel at its empty value; NULL + err when out of memory. */
+static OuterBuffer *buffer_alloc(OuterKind kind, size_t texels, Error *err)
 {
-    const ShadowMap *m = st->sm.map;
-    size_t texels = (size_t)m->num_faces * (size_t)m->res * (size_t)m->res;
-    st->value = malloc(sizeof *st->value * texels);
-    st->depth = buffer_floats(st->kind) == 2 ? malloc(sizeof *st->depth * texels) : NULL;
-    FaceEdge *edges = malloc(sizeof *edges * (size_t)(sil->num_edges > 0 ? sil->num_edges : 1));
-    if (!st->value || (buffer_floats(st->kind) == 2 && !st->depth) || !edges) {
-        free(edges);
-        return error_set(err, "out of memory: the %s buffer of %zu texels",
-                         st->kind == OUTER_SMOOTHIES ? "smoothie" : "penumbra map", texels);
+    OuterBuffer *b = calloc(1, sizeof *b);
+    if (b) {
+        b->texels = texels;
+        b->value = malloc(sizeof *b->value * texels);
+        b->depth = buffer_floats(kind) == 2 ? malloc(sizeof *b->depth * texels) : NULL;
+    }
+    if (!b || !b->value || (buffer_floats(kind) == 2 && !b->depth)) {
+        buffer_free(b);
+        error_set(err, "out of memory: the %s of %zu texels", kind_buffer[kind].name, texels);
+        return NULL;
     }
     for (size_t k = 0; k < texels; k++) {
-        st->value[k] = st->kind == OUTER_SMOOTHIES ? 1.0f : 0.0f;
-        if (st->depth) st->depth[k] = INFINITY;
+        b->value[k] = kind == OUTER_SMOOTHIES ? 1.0f : 0.0f;
+        if (b->depth) b->depth[k] = INFINITY;
+    }
+    return b;
+}
+
+/* The resource's build: every face's projected edges drawn into a fresh
+ * buffer. The projected edges are build scratch, freed before it returns. */
+static void *build_buffer(const void *args, Error *err)
+{
+    const BufferArgs *a = args;
+    const OuterState *st = a->st;
+    const ShadowMap *m = st->sm.map;
+    const Silhouette *sil = a->sil;
+    OuterBuffer *buf = buffer_alloc(st->kind, (size_t)m->num_faces * (size_t)m->res * (size_t)m->res, err);
+    FaceEdge *edges = buf ? malloc(sizeof *edges * (size_t)(sil->num_edges > 0 ? sil->num_edges : 1)) : NULL;
+    if (!edges) {
+        if (buf) error_set(err, "out of memory: %d silhouette edges", sil->num_edges);
+        buffer_free(buf);
+        return NULL;
     }
     for (int face = 0; face < m->num_faces; face++) {
         const MapFace *f = &m->view.face[face];
@@ -261,10 +310,32 @@ static bool draw_buffer(OuterState *st, const Silhouette *sil, Error *err)
                 edges[n].radius = band_radius(st, f, &edges[n]);
                 n++;
             }
-        draw_face(st, face, edges, n);
+        draw_face(st, buf, face, edges, n);
     }
     free(edges);
-    return true;
+    return buf;
+}
+
+/* The buffer, keyed by exactly what build_buffer reads: the hard map (its
+ * depths and faces' frames), the silhouette, and the band's one parameter,
+ * smoothies' t or the penumbra map's R; the bias is left out (evaluate's). */
+static const OuterBuffer *res_outer_buffer(ResourceManager *rm, const OuterState *st, const Silhouette *sil,
+                                           Error *err)
+{
+    const ShadowMap *m = st->sm.map;
+    double band = st->kind == OUTER_SMOOTHIES ? st->smoothie_width : st->light_radius;
+    Hasher h;
+    hash_init(&h);
+    hash_str(&h, kind_buffer[st->kind].name);
+    hash_u64(&h, m->key);
+    hash_u64(&h, sil->key);
+    hash_f64(&h, band);
+    char desc[160], mk[17];
+    hash_hex(m->key, mk);
+    snprintf(desc, sizeof desc, "%s of map %s (%d x %d^2), %d edges, %s %.6g", kind_buffer[st->kind].name, mk,
+             m->num_faces, m->res, sil->num_edges, st->kind == OUTER_SMOOTHIES ? "t" : "R", band);
+    BufferArgs a = {st, sil};
+    return rm_acquire(rm, &kind_buffer[st->kind], hash_final(&h), desc, build_buffer, &a, err);
 }
 
 /* z_c of the smoothie width: the mean distance of the silhouette's edge ends
@@ -311,7 +382,7 @@ static bool outer_prepare(const TechContext *ctx, OuterKind kind, const char *na
         /* t = width D / z_c (header); no silhouette: nothing is drawn, any positive t serves */
         st->smoothie_width = z_c > 0.0 ? p[P_WIDTH] * 2.0 * st->light_radius / z_c : 1.0;
     }
-    if (!sil || !draw_buffer(st, sil, err)) {
+    if (!sil || !(st->buf = res_outer_buffer(ctx->rm, st, sil, err))) {
         outer_release(st);
         return false;
     }
@@ -336,12 +407,13 @@ static float outer_lit(const OuterState *st, const SmapReceiver *r, int i, int j
     i = i < 0 ? 0 : i >= m->res ? m->res - 1 : i;
     j = j < 0 ? 0 : j >= m->res ? m->res - 1 : j;
     size_t k = texel_index(m, r->mc.face, i, j);
-    work_texels(buffer_floats(st->kind), sizeof *st->value); /* the buffer's texel (core/counters.h) */
-    if (st->kind == OUTER_PENUMBRA_MAP) return 1.0f - st->value[k]; /* Wyman & Hansen's I is the shadow's */
-    double z_s = st->depth[k], z_r = r->mc.depth_linear;
+    const OuterBuffer *b = st->buf;
+    work_texels(buffer_floats(st->kind), sizeof *b->value); /* the buffer's texel (core/counters.h) */
+    if (st->kind == OUTER_PENUMBRA_MAP) return 1.0f - b->value[k]; /* Wyman & Hansen's I is the shadow's */
+    double z_s = b->depth[k], z_r = r->mc.depth_linear;
     if (!(z_r > z_s)) return 1.0f; /* in front of the smoothie, or none here */
     /* Chan & Durand 2003: alpha' = alpha / (1 - z_s / z_r), clamped; z_r > z_s > 0, so the ratio is > 0 */
-    return (float)nan_clamp(st->value[k] / parker_ratio((float)(z_r - z_s), (float)z_r), 0.0, 1.0);
+    return (float)nan_clamp(b->value[k] / parker_ratio((float)(z_r - z_s), (float)z_r), 0.0, 1.0);
 }
 
 static void outer_evaluate(const void *state, const TechContext *ctx, int begin, int end, float *out)
@@ -371,7 +443,7 @@ const Technique tech_smoothies = {
                "distance / width, min-blended, rescaled by Parker's ratio: outer penumbra only",
     .params = smoothie_params,
     .num_params = (int)(sizeof smoothie_params / sizeof smoothie_params[0]),
-    .resources = outer_resources,
+    .resources = smoothie_resources,
     .rgb = false,
     .lights = OUTER_LIGHTS,
     .main_param = "width",
@@ -388,7 +460,7 @@ const Technique tech_penumbra_map = {
                "from the light's radius; visibility 1 - I, I = 1 - (Z_P - Z_V) / (Z_F - Z_V): outer penumbra only",
     .params = penumbra_params,
     .num_params = (int)(sizeof penumbra_params / sizeof penumbra_params[0]),
-    .resources = outer_resources,
+    .resources = penumbra_resources,
     .rgb = false,
     .lights = OUTER_LIGHTS,
     .main_param = "map_size",

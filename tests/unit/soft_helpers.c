@@ -1,6 +1,7 @@
 /* soft_helpers.c -- labs, renders and comparisons for the soft-shadow map tests. */
 #include "soft_helpers.h"
 #include <stdio.h>
+#include <string.h>
 #include "fixtures.h"
 #include "techniques/smap.h"
 
@@ -60,6 +61,22 @@ bool soft_render(Lab *lab, const char *tech, const char *const *params, RenderRe
     if (t && lab_render(lab, &rq, out, &err)) return true;
     printf("    %s: %s\n", tech, err.msg);
     return false;
+}
+
+bool soft_render_event(Lab *lab, const char *tech, const char *const *params, const char *kind, bool *built,
+                       size_t *bytes)
+{
+    RenderResult r;
+    if (!soft_render(lab, tech, params, &r)) return false;
+    bool found = false;
+    for (int e = 0; e < r.num_tech_resources && !found; e++)
+        if ((found = strcmp(r.tech_resources[e].kind, kind) == 0)) {
+            *built = r.tech_resources[e].built;
+            *bytes = r.tech_resources[e].bytes;
+        }
+    render_result_free(&r);
+    if (!found) printf("    %s: no %s in the run's resources\n", tech, kind);
+    return found;
 }
 
 bool soft_metrics(Lab *lab, const Image *v, int samples, Metrics *m)

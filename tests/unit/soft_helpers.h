@@ -20,6 +20,12 @@ double soft_map_dx(Lab *lab, const char *tech, int map_size);
 
 /* Render `tech` on light 1 with the NULL-terminated "name=value" list. */
 bool soft_render(Lab *lab, const char *tech, const char *const *params, RenderResult *out);
+/* Render `tech` as soft_render does, then find `kind` in the resources its
+ * prepare acquired (RenderResult.tech_resources, the run's resource log):
+ * whether it was built (false: reused) and its bytes; false when the render
+ * fails or it acquired no such resource. */
+bool soft_render_event(Lab *lab, const char *tech, const char *const *params, const char *kind, bool *built,
+                       size_t *bytes);
 /* Metrics against a `samples`-sample stratified reference (seed 1, no disk cache). */
 bool soft_metrics(Lab *lab, const Image *v, int samples, Metrics *m);
 

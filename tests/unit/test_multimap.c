@@ -163,3 +163,25 @@ TEST(test_layered_attenuation_caps_and_refusals)
     lab_close(lab);
     omp_set_num_threads(threads);
 }
+
+/* The LDI is a keyed resource: the same parameters again reuse it (every
+ * parameter of the technique is one the LDI is built from), a new epsilon
+ * rebuilds it, and the log counts its bytes: at least a depth, a count and a
+ * last sample per layer of every texel of one 64^2 face. */
+TEST(test_layered_attenuation_ldi_is_a_keyed_resource)
+{
+    Lab *lab = soft_open("sphere-on-plane.lua", NULL);
+    CHECK(lab);
+    const char *const base[] = {"map_size=64", "samples=4", "layers=4", NULL};
+    const char *const other[] = {"map_size=64", "samples=4", "layers=4", "epsilon=0.2", NULL};
+    const char *const *runs[] = {base, base, other};
+    bool built[3] = {false, true, false};
+    size_t bytes[3] = {0, 0, 0};
+    for (int k = 0; lab && k < 3; k++)
+        CHECK(soft_render_event(lab, "layered_attenuation", runs[k], "layered_attenuation_ldi", &built[k], &bytes[k]));
+    printf("    layered_attenuation_ldi: built %d, again %d, at epsilon 0.2 %d; %zu bytes\n", built[0], built[1],
+           built[2], bytes[0]);
+    CHECK_MSG(built[0] && !built[1] && built[2], "built %d %d %d", built[0], built[1], built[2]);
+    CHECK(bytes[0] >= (size_t)4 * (sizeof(float) + 2 * sizeof(uint16_t)) * 64 * 64 && bytes[2] == bytes[0]);
+    lab_close(lab);
+}

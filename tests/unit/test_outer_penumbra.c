@@ -365,3 +365,29 @@ TEST(test_outer_penumbra_refuses_buffers_above_the_map_cap)
     CHECK_MSG(strstr(err.msg, "map_size 16384") && strstr(err.msg, "up to 13377"), "message: %s", err.msg);
     lab_close(lab);
 }
+
+/* The light-space buffer is a keyed resource: a bias change (read by
+ * evaluate only) reuses it, a change of what it is drawn from rebuilds it,
+ * and the log counts its floats (2 per texel for smoothies, 1 for the
+ * penumbra map) of at least one 256^2 face. */
+TEST(test_outer_penumbra_buffers_are_keyed_resources)
+{
+    static const char *const kinds[] = {"smoothie_buffer", "penumbra_map_buffer"};
+    static const char *const changed[] = {"width=2", "map_size=128"};
+    Lab *lab = soft_open("sphere-on-plane.lua", NULL);
+    CHECK(lab);
+    for (int k = 0; lab && k < 2; k++) {
+        const char *const base[] = {"map_size=256", NULL}, *const biased[] = {"map_size=256", "bias=0.05", NULL};
+        const char *const other[] = {"map_size=256", changed[k], NULL};
+        bool built[3] = {false, true, false};
+        size_t bytes[3] = {0, 0, 0};
+        CHECK(soft_render_event(lab, outer_techs[k], base, kinds[k], &built[0], &bytes[0]));
+        CHECK(soft_render_event(lab, outer_techs[k], biased, kinds[k], &built[1], &bytes[1]));
+        CHECK(soft_render_event(lab, outer_techs[k], other, kinds[k], &built[2], &bytes[2]));
+        printf("    %s: built %d, after a bias change %d, after %s %d; %zu bytes\n", kinds[k], built[0], built[1],
+               changed[k], built[2], bytes[0]);
+        CHECK_MSG(built[0] && !built[1] && built[2], "%s built %d %d %d", kinds[k], built[0], built[1], built[2]);
+        CHECK(bytes[0] >= (size_t)(2 - k) * sizeof(float) * 256 * 256 && bytes[1] == bytes[0]);
+    }
+    lab_close(lab);
+}
