@@ -87,6 +87,7 @@ for s in scenes/sphere-on-plane.lua scenes/bunny.lua; do
         -o "$out/reference_scaling.csv"
 done
 run "$bin/raster_threads" --res 2048 --threads "$threads" --repeat "$repeat" -o "$out" scenes/bunny.lua scenes/million.lua
+for kib in 256 4096; do run "$bin/coherence" --kib "$kib" --repeat 9 -o "$out"; done
 run "$bin/techniques" --only threads --threads "$threads" --repeat "$repeat" -o "$out"
 
 step 6 "peak memory against the resources' bytes, 4096^2 maps"
