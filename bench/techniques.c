@@ -10,7 +10,8 @@
  *     against triangle count (the scene's objects[2].segments) and against
  *     image size (camera.width x camera.height at 4:3); --quick: one of
  *     these four axes a technique, rotating with its registry index
- *     (growth_axis), maps up to 1024^2;
+ *     (growth_axis), maps up to 1024^2, and a point's builds and evaluations
+ *     each stop once they took GROWTH_QUICK_BUDGET_S;
  *   constant: techniques with a summed-area-table prefilter (a `prefilter`
  *     choice named sat) at K = its minimum and maximum: frame time at the
  *     largest K within 1.2x of the smallest (the papers' claim);
@@ -67,6 +68,11 @@
 #define WHERE_HEADER "scene,light,settings,width,height," BENCH_TAIL_HEADER "\n"
 #define GROWTH_HEADER "technique,axis,value,frame_ms,eval_ms,build_ms,resources_built,note," WHERE_HEADER
 #define CONSTANT_HEADER "technique,prefilter,K_min,K_max,frame_min_ms,frame_max_ms,ratio,bound,within," WHERE_HEADER
+/* --quick: a growth point's builds and evaluations each stop once they took
+ * this long (lab.h RenderTiming; a 1024^2 cssm moment map builds in about 2 s
+ * and was built 4 times a point: the growth step took 11 of QUICK's minutes). */
+#define GROWTH_QUICK_BUDGET_S 1.0
+
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup,cpu_ms_1,cpu_ms_n,busiest_ms_n,cpu_bound,evals," WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
                           "eval_small_ms,eval_large_ms,eval_ratio,bytes_small,bytes_large,bytes_ratio,note," \
@@ -273,10 +279,11 @@ static void announce(const Options *o, const Subject *sj, const char *what)
 }
 
 /* One warm-up then o->c.repeat timed evaluations (lab.h's timing). */
-static bool measure(Lab *lab, const Technique *t, const double *params, int repeat, Point *p, Error *err)
+static bool measure_within(Lab *lab, const Technique *t, const double *params, int repeat, double budget_s, Point *p,
+                           Error *err)
 {
     RenderRequest req = {.tech = t, .params = params, .light_index = 0, .repeat = repeat};
-    RenderTiming timing = {.warmup = 1, .budget_s = 0.0};
+    RenderTiming timing = {.warmup = 1, .budget_s = budget_s};
     RenderResult r;
     if (!lab_render_timed(lab, &req, &timing, &r, err)) return false;
     double lit = r.lit_candidates > 0 ? (double)r.lit_candidates : NAN; /* none lit: NaN, shown */
@@ -285,6 +292,12 @@ static bool measure(Lab *lab, const Technique *t, const double *params, int repe
     for (int i = 0; i < r.num_tech_resources; i++) p->built += r.tech_resources[i].built;
     render_result_free(&r);
     return true;
+}
+
+/* measure_within with exactly `repeat` timed builds and evaluations. */
+static bool measure(Lab *lab, const Technique *t, const double *params, int repeat, Point *p, Error *err)
+{
+    return measure_within(lab, t, params, repeat, 0.0, p, err);
 }
 
 /* ---- growth ---------------------------------------------------------------- */
@@ -320,7 +333,7 @@ static bool growth_point(const Options *o, Lab *lab, Subject *sj, const double *
     char row[4096], end[1024], note[1100] = "", timings[160];
     Point p;
     Error refusal;
-    if (measure(lab, sj->t, params, o->c.repeat, &p, &refusal)) {
+    if (measure_within(lab, sj->t, params, o->c.repeat, o->quick ? GROWTH_QUICK_BUDGET_S : 0.0, &p, &refusal)) {
         snprintf(timings, sizeof timings, "%.4f,%.4f,%.4f,%d", p.frame_s * 1e3, p.eval_s * 1e3, p.build_s * 1e3,
                  p.built);
         printf("  %-18s %-16s %10g: frame %9.3f ms, eval %9.3f ms, build %9.3f ms\n", sj->t->name, axis, value,
