@@ -143,7 +143,6 @@ for _, t in ipairs({ "backprojection", "hsm", "mssm", "ysm" }) do EXPECTED[t] = 
 
 local args = experiment.parse_args(arg, {
   scenes = { default = "", help = "comma-separated scene files of scenes/ (empty: all but million.lua)" },
-  param = { default = "", help = "TECH:KEY=VALUE[,TECH:KEY=VALUE...]: run a technique off its defaults" },
 })
 
 local function split(text)
@@ -157,14 +156,6 @@ if #names == 0 then
   for _, f in ipairs(sl.dir(sl.root .. "/scenes") or {}) do
     if f:match("%.lua$") and not SKIP[f] then names[#names + 1] = f end
   end
-end
-
-local off_default = {}
-for _, item in ipairs(split(args.extra.param)) do
-  local t, k, v = item:match("^([%w_]+):([%w_]+)=(.+)$")
-  if not t then error("--param expects TECH:KEY=VALUE, got '" .. item .. "'", 0) end
-  off_default[t] = off_default[t] or {}
-  off_default[t][k] = tonumber(v) or (v == "true" or v == "false") and v == "true" or v
 end
 
 local exp = experiment.new{
@@ -185,8 +176,7 @@ for _, name in ipairs(names) do
   end
 end
 for _, s in ipairs(skipped) do print("skipped " .. s) end
-exp:add_registry{ points = function(t) return off_default[t.name] and { off_default[t.name] } or nil end }
-for t in pairs(off_default) do sl.technique(t) end -- an unknown name is an error, not a silent default
+exp:add_registry() -- at their defaults; --param runs one off them (experiment.lua)
 
 local result = exp:run(args)
 

@@ -65,6 +65,8 @@ end
 if #TECHNIQUES == 0 then error("soft-failures: no registered technique of family " .. args.extra.family ..
                                " handles " .. LIGHT .. " lights", 0) end
 
+local FIXED = experiment.fixed_params(args.params, TECHNIQUES) -- --param: e.g. map_size=256 in the tests
+
 local function log(...) if not quiet then io.stderr:write(string.format(...), "\n") end end
 local function finite(x) return type(x) == "number" and x == x and x ~= math.huge and x ~= -math.huge end
 local function scene_path(name) return sl.root .. "/scenes/" .. name .. ".lua" end
@@ -94,7 +96,8 @@ local function reference(lab)
 end
 
 local function estimate(lab, technique)
-  local run = lab:compare{ technique = technique, samples = SAMPLES, png = false, exr = false }
+  local run = lab:compare{ technique = technique, params = FIXED[technique], samples = SAMPLES, png = false,
+                           exr = false }
   return pixels(run, "visibility")
 end
 

@@ -137,6 +137,8 @@ experiment options:
   --warmup N       untimed evaluations before them
   --samples N      reference light samples per view sample
   -s, --set K=V    scene override for every scene, e.g. --set camera.width=160 (repeatable)
+  --param [T:]K=V  parameter K of technique T (no T: of every technique that has K) at V in every
+                   configuration, e.g. --param map_size=256 (repeatable; points that become equal run once)
   --no-images      no PNG images per configuration (smaller, faster; the report shows plots only)
   --quiet          no progress lines
   -h, --help       this list (and the script's own options)]]
@@ -174,7 +176,7 @@ end
 -- `extra` declares the script's own options, {name = {default =, help =}}:
 -- their values (strings) are in o.extra. Pass the result to exp:run.
 function experiment.parse_args(argv, extra)
-  local o, i = { shard = { index = 0, count = 1 }, set = {}, extra = {}, parsed = true }, 1
+  local o, i = { shard = { index = 0, count = 1 }, set = {}, params = {}, extra = {}, parsed = true }, 1
   for name, spec in pairs(extra or {}) do o.extra[name] = spec.default end
   while argv and argv[i] do
     local a = argv[i]
@@ -188,6 +190,13 @@ function experiment.parse_args(argv, extra)
       local k, v = (argv[i + 1] or ""):match("^([^=]+)=(.+)$")
       if not k then usage_error(a .. " expects KEY=VALUE, e.g. camera.width=160") end
       o.set[k] = override_value(v)
+      i = i + 1
+    elseif a == "--param" then
+      local text = argv[i + 1] or ""
+      local t, k, v = text:match("^([%w_]+):([%w_]+)=(.+)$")
+      if not t then k, v = text:match("^([%w_]+)=(.+)$") end
+      if not k then usage_error(a .. " expects [TECH:]KEY=VALUE, e.g. map_size=256 or pcf:K=5") end
+      o.params[#o.params + 1] = { technique = t, key = k, value = override_value(v) }
       i = i + 1
     elseif a == "--shard" then
       local si, sn = (argv[i + 1] or ""):match("^(%d+)/(%d+)$")
@@ -455,6 +464,55 @@ local function refuse_mixed_builds(o, writer, mine)
   end
 end
 
+local function has_param(desc, key)
+  for _, p in ipairs(desc.params) do
+    if p.name == key then return true end
+  end
+  return false
+end
+
+-- --param (parse_args's o.params) for the techniques named: {name = {key =
+-- value}}, each name's values checked against the registry's ranges. An
+-- unknown technique, or a --param that no technique named has, is an error.
+-- Scripts that run their own loop (soft-failures) pass these to lab:compare.
+function experiment.fixed_params(fixed, names)
+  local by_name = {}
+  for _, f in ipairs(fixed or {}) do
+    local flag = "--param " .. (f.technique and f.technique .. ":" or "") .. f.key
+    local known, why = pcall(sl.technique, f.technique or "hard")
+    if not known then error(flag .. ": " .. tostring(why), 0) end
+    local used = false
+    for _, name in ipairs(names) do
+      if (f.technique == nil or f.technique == name) and has_param(sl.technique(name), f.key) then
+        by_name[name] = by_name[name] or {}
+        by_name[name][f.key] = f.value
+        local ok, err = pcall(sl.params, name, by_name[name])
+        if not ok then error(flag .. ": " .. tostring(err), 0) end
+        used = true
+      end
+    end
+    if not used then error(flag .. ": no technique of this experiment has a parameter " .. f.key, 0) end
+  end
+  return by_name
+end
+
+-- Each entry's point with the --param values of its technique (a point that
+-- becomes another's runs once: configurations() keeps one per key).
+function Experiment:fix_params(fixed)
+  local names = {}
+  for _, e in ipairs(self.entries) do names[#names + 1] = e.technique.name end
+  local by_name = experiment.fixed_params(fixed, names)
+  for _, e in ipairs(self.entries) do
+    local values = by_name[e.technique.name]
+    if values then
+      local p = {}
+      for k, v in pairs(e.swept) do p[k] = v end
+      for k, v in pairs(values) do p[k] = v end
+      e.swept, e.params = p, sl.params(e.technique.name, p)
+    end
+  end
+end
+
 -- Run the experiment with the script's arguments (arg, or parse_args's
 -- result). Returns a result table:
 -- rows (this output's rows in configuration order), out, sharded, computed,
@@ -473,6 +531,7 @@ function Experiment:run(argv)
     for _, variant in ipairs(self.variants) do variant.overrides[k] = v end
   end
   if #self.entries == 0 then error("experiment " .. self.name .. ": no techniques added", 0) end
+  self:fix_params(o.params)
   if #self.variants == 0 then error("experiment " .. self.name .. ": no scenes", 0) end
   local configs = self:configurations()
   local writer, header = self:open_results(o, configs)

@@ -85,6 +85,15 @@ expect run_help_lists_every_experiment_option 0 --out --resume --fresh --mixed-b
     --samples --set --no-images --quiet -- "$SL" run --help
 expect experiment_unknown_argument 2 "unknown argument '--frob'" -- "$SL" run "$SWEEP" --frob
 expect experiment_bad_shard 2 "--shard expects I/N" -- "$SL" run "$SWEEP" --shard 2/2
+# --param fixes a parameter in every configuration: the sweep's three offsets become one point a variant
+expect param_fixes_every_point 0 "2 computed" "offset_scale=2" -- \
+    "$SL" run "$SWEEP" --param offset_scale=2 --out "$TMP/param" --no-images
+expect param_out_of_range_names_the_range 1 "--param hard:offset_scale" "[0, 10000]" -- \
+    "$SL" run "$SWEEP" --param hard:offset_scale=20000 --out "$TMP/param-bad"
+expect param_nobody_has_is_refused 1 "no technique of this experiment has a parameter map_size" -- \
+    "$SL" run "$SWEEP" --param map_size=256 --out "$TMP/param-bad"
+expect param_unknown_technique_is_refused 1 "unknown technique 'pfc'" -- \
+    "$SL" run "$SWEEP" --param pfc:K=3 --out "$TMP/param-bad"
 expect nonfinite_params_refused_from_lua 0 "refusals checked" -- "$SL" run tests/lua/nonfinite-params.lua
 
 # ---- the unsharded sweep (with images: the browser test opens its report)
@@ -225,7 +234,10 @@ grep -q "mixed builds" "$TMP/stale/index.html" && ok report_names_mixed_builds |
 
 # ---- the shipped experiments at tiny settings (the default runs are the README's)
 TINY="--set camera.width=32 --set camera.height=24 --samples 4 --repeat 1 --warmup 0 --no-images"
-expect error_vs_time_runs 0 "report:" -- "$SL" run experiments/error-vs-time.lua --factors 1 $TINY --out "$TMP/evt"
+# (maps at 256^2: at the defaults penumbra_deep_map, cssm and csm build 2048^2 cube maps and moment maps,
+# 130 of the run's 205 frame seconds)
+expect error_vs_time_runs 0 "report:" -- "$SL" run experiments/error-vs-time.lua --factors 1 $TINY \
+    --param map_size=256 --out "$TMP/evt"
 expect error_vs_time_plot_shows_every_registered_technique 0 "every registered technique" -- \
     "$SL" run tests/lua/every-technique.lua "$TMP/evt"
 expect smrt_rays_steps_runs 0 "42 computed" "0 failed" "report:" -- \
@@ -267,8 +279,10 @@ mkdir -p "$R"
 TINYQ="$TINY --quiet --threads 1"
 run_repro() { # run_repro EXPERIMENT ARGS...: its output in $R/EXPERIMENT.log, its exit status in .rc
     e=$1; shift
+    t0=$(date +%s)
     "$SL" run "experiments/$e.lua" "$@" --out "$R/$e" >"$R/$e.log" 2>&1
     echo $? >"$R/$e.rc"
+    echo "$(($(date +%s) - t0)) s $e" >>"$R/wall-times"
 }
 (
     run_repro fig3-13-storage-factor --points 6
@@ -277,7 +291,8 @@ run_repro() { # run_repro EXPERIMENT ARGS...: its output in $R/EXPERIMENT.log, i
     run_repro course-fig2.3-midpoint $TINYQ
     run_repro course-fig4.5-vsm-bleeding --map-size 128 $TINYQ
     run_repro fig3-7-aliasing-vs-z --map-size 256
-    run_repro soft-failures --set camera.width=40 --set camera.height=30 --samples 16 --quiet --threads 1
+    run_repro soft-failures --set camera.width=40 --set camera.height=30 --samples 16 --quiet --threads 1 \
+        --param map_size=256 # 8 s; 201 s at the default maps (penumbra_deep_map's and cssm's builds)
     run_repro course-fig5.10-5.11-multiscale --set camera.width=80 --set camera.height=60 --samples 16 --repeat 1 \
         --warmup 0 --no-images --quiet --threads 1 # ~20 s on a loaded machine
     run_repro course-fig5.5-5.8-occluders --set camera.width=48 --set camera.height=36 --samples 16 --repeat 1 \
@@ -303,6 +318,7 @@ run_repro exact-soft-vs-rays --quick 1 --set camera.width=48 --set camera.height
 run_repro course-ch7-backprojection-vs-pcss --set camera.width=48 --set camera.height=36 --samples 16 --repeat 1 \
     --warmup 0 --no-images --quiet --threads 1 # ~5 s with the bunny
 wait "$lane"
+echo "(the reproductions' wall times, two lanes: $(sort -rn "$R/wall-times" | tr '\n' ',' | sed 's/,$//; s/,/, /g'))"
 for e in seed000-fig3 seed001-adaptive-area seed002-single-sample seed003-shadow-width seed003-table1 \
          course-fig2.2-bias course-fig2.3-midpoint course-fig4.3-pcf-umbra course-fig4.5-vsm-bleeding \
          course-fig4.7-csm-terms course-fig5.10-5.11-multiscale course-fig5.14-outer-penumbra fig3-7-aliasing-vs-z \
