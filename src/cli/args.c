@@ -40,7 +40,7 @@ static const OptDesc opts[OPT_COUNT] = {
     [OPT_NAMES] = {NULL, "--names", NULL, "the names only, one per line"},
     [OPT_CASE] = {NULL, "--case", "TEXT", "only cases whose name contains TEXT"},
     [OPT_QUICK] = {NULL, "--quick", NULL, "reduced sizes"},
-    [OPT_SAMPLE] = {NULL, "--sample", "K/M", "a deterministic sample of the runs"},
+    [OPT_SAMPLE] = {NULL, "--sample", "K/M", "a deterministic sample of the runs (!K/M: the others)"},
     [OPT_TIMEOUT] = {NULL, "--timeout", "S",
                      "per-run time bound in seconds (default 120; 3x for the heavy cases: a 4096^2 image, 10^6 "
                      "triangles)"},
@@ -59,8 +59,12 @@ static bool parse_int(const char *opt, const char *s, int lo, int hi, int *out, 
 }
 
 /* "K/M" with 0 <= K < M <= 64. */
-static bool parse_sample(const char *a, const char *v, int *k, int *m, Error *err)
+/* --sample K/M, or !K/M for its complement. */
+static bool parse_sample(const char *a, const char *v, int *k, int *m, bool *invert, Error *err)
 {
+    const char *text = v;
+    *invert = v[0] == '!';
+    v += *invert;
     char *end;
     long kk = strtol(v, &end, 10), mm = 0;
     if (end != v && *end == '/') {
@@ -69,7 +73,7 @@ static bool parse_sample(const char *a, const char *v, int *k, int *m, Error *er
         if (end == mv) mm = 0;
     }
     if (*end != '\0' || mm < 1 || mm > 64 || kk < 0 || kk >= mm)
-        return error_set(err, "%s expects K/M with 0 <= K < M <= 64, got '%s'", a, v);
+        return error_set(err, "%s expects K/M or !K/M with 0 <= K < M <= 64, got '%s'", a, text);
     *k = (int)kk;
     *m = (int)mm;
     return true;
@@ -127,7 +131,7 @@ static bool apply(CliOpt id, const char *a, const char *v, CliOptions *o, Error 
     case OPT_NAMES: o->names = true; return true;
     case OPT_CASE: o->case_filter = v; return true;
     case OPT_QUICK: o->quick = true; return true;
-    case OPT_SAMPLE: return parse_sample(a, v, &o->sample_k, &o->sample_m, err);
+    case OPT_SAMPLE: return parse_sample(a, v, &o->sample_k, &o->sample_m, &o->sample_invert, err);
     case OPT_TIMEOUT: return parse_seconds(a, v, 1, 86400, &o->timeout_s, err);
     case OPT_JOBS: return parse_int(a, v, 1, 16, &o->jobs, err);
     case OPT_LIST: o->list = true; return true;

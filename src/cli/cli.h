@@ -56,6 +56,7 @@ typedef struct CliOptions {
     double timeout_s;      /* stability: per run (0: the suite's default) */
     int jobs;              /* stability: runs at once (0: 1) */
     int sample_k, sample_m; /* stability: --sample K/M, the runs of hash class K of M (m 0: all) */
+    bool sample_invert;     /* --sample !K/M: the runs of every class but K */
     unsigned long long given; /* bit (1ull << CliOpt) of every option given */
 } CliOptions;
 

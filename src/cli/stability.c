@@ -22,7 +22,8 @@ static const CliAccept stability_options[] = {
                 "cases), map sizes capped at 128 texels except in their own probes, one row\n"
                 "per parameter for all its probes; every case runs"},
     {OPT_SAMPLE, "only the runs whose hash of (technique, case, light) falls in class K of M: every\n"
-                 "technique keeps about 1/M of its rows (make test's sanitized pass)"},
+                 "technique keeps about 1/M of its rows (make test's sanitized pass); !K/M: every\n"
+                 "class but K (make test's optimised pass)"},
     {OPT_TIMEOUT, NULL},
     {OPT_THREADS, "threads per run (default: the cores divided among --jobs)"},
     {OPT_JOBS, NULL},
@@ -86,7 +87,7 @@ static bool run_suite(const CliOptions *c, const Technique *t, Rows *rows, Error
     snprintf(scenes, sizeof scenes, "%s/scenes", c->out_dir ? c->out_dir : "");
     StabOptions o = {.quick = c->quick, .timeout_s = c->timeout_s, .threads = c->threads, .only = c->case_filter,
                      .work_dir = work, .scene_dir = c->out_dir ? scenes : NULL, .jobs = c->jobs,
-                     .sample_k = c->sample_k, .sample_m = c->sample_m};
+                     .sample_k = c->sample_k, .sample_m = c->sample_m, .sample_invert = c->sample_invert};
     const Technique *one[1] = {t};
     Progress prog; /* no heartbeat: stab_run forks, so this process stays single-threaded */
     progress_begin(&prog, "stability", 0);

@@ -151,7 +151,7 @@ static bool sampled(const Runner *rn, const Technique *t, const char *name, Ligh
     hash_str(&h, t ? t->name : "(engine)");
     hash_str(&h, name);
     hash_u64(&h, (uint64_t)kind);
-    return hash_final(&h) % (uint64_t)rn->o->sample_m == (uint64_t)rn->o->sample_k;
+    return (hash_final(&h) % (uint64_t)rn->o->sample_m == (uint64_t)rn->o->sample_k) != rn->o->sample_invert;
 }
 
 static void add_job(Runner *rn, const Technique *t, const StabCase *c, int param, ParamProbe probe, LightKind kind,

@@ -30,6 +30,7 @@ typedef struct StabOptions {
     int jobs;              /* runs at once; 0: 1 */
     int sample_k, sample_m; /* sample_m > 1: only the runs whose FNV-1a hash of "technique case light"
                              * is K modulo M, a deterministic sample; every technique keeps ~1/M */
+    bool sample_invert;     /* the runs of every class but K instead */
 } StabOptions;
 
 /* Quick runs: view size, reference light samples, and the cap on integer
