@@ -479,8 +479,10 @@ function experiment.fixed_params(fixed, names)
   local by_name = {}
   for _, f in ipairs(fixed or {}) do
     local flag = "--param " .. (f.technique and f.technique .. ":" or "") .. f.key
-    local known, why = pcall(sl.technique, f.technique or "hard")
-    if not known then error(flag .. ": " .. tostring(why), 0) end
+    if f.technique then
+      local known, why = pcall(sl.technique, f.technique)
+      if not known then error(flag .. ": " .. tostring(why), 0) end
+    end
     local used = false
     for _, name in ipairs(names) do
       if (f.technique == nil or f.technique == name) and has_param(sl.technique(name), f.key) then

@@ -58,8 +58,7 @@ static bool parse_int(const char *opt, const char *s, int lo, int hi, int *out, 
     return true;
 }
 
-/* "K/M" with 0 <= K < M <= 64. */
-/* --sample K/M, or !K/M for its complement. */
+/* --sample "K/M" with 0 <= K < M <= 64, or "!K/M" for its complement. */
 static bool parse_sample(const char *a, const char *v, int *k, int *m, bool *invert, Error *err)
 {
     const char *text = v;

@@ -167,25 +167,29 @@ static int run_parallel(const int *selected, int n, int jobs, int *passed, int *
     for (int k = 0; k < n; k++) write_all(work[1], &selected[k], sizeof selected[k]);
     close(work[1]);
     Worker ws[16];
+    int open = 0;
     fflush(stdout);
     for (int j = 0; j < jobs; j++) {
         int out[2];
-        if (pipe(out) != 0) { perror("test_unit: pipe"); return 1; }
+        ws[j] = (Worker){.pid = -1, .fd = -1, .running = -1, .open = false};
+        if (pipe(out) != 0) { perror("test_unit: pipe"); continue; }
         pid_t pid = fork();
         if (pid == 0) {
             close(out[0]);
-            for (int k = 0; k < j; k++) close(ws[k].fd);
+            for (int k = 0; k < j; k++)
+                if (ws[k].open) close(ws[k].fd);
             int code = worker(work[0], out[1]);
             close(out[1]);
             exit(code); /* through atexit: LeakSanitizer checks the worker */
         }
         close(out[1]);
-        ws[j] = (Worker){.pid = pid, .fd = out[0], .running = -1, .open = pid > 0};
-        if (pid < 0) { perror("test_unit: fork"); close(out[0]); }
+        if (pid < 0) { perror("test_unit: fork"); close(out[0]); continue; }
+        ws[j] = (Worker){.pid = pid, .fd = out[0], .running = -1, .open = true};
+        open++;
     }
     close(work[0]);
-    int status = 0;
-    for (int open = jobs; open > 0;) {
+    int status = open > 0 ? 0 : 1; /* no worker started: nothing ran */
+    while (open > 0) {
         struct pollfd fds[16];
         for (int j = 0; j < jobs; j++) fds[j] = (struct pollfd){.fd = ws[j].open ? ws[j].fd : -1, .events = POLLIN};
         if (poll(fds, (nfds_t)jobs, -1) < 0) continue;
