@@ -422,6 +422,12 @@ trap 'rm -f "$cmp" "$gone" "$sum" "$md.tmp$$"' EXIT
     echo
     sed 's/^/    /' "$dir/load.txt" 2>/dev/null || true
     echo
+    if [ -s "$dir/steps.txt" ]; then
+        echo "Wall time of each step and of each program in it (run.sh's \`steps.txt\`):"
+        echo
+        sed 's/^/    /' "$dir/steps.txt"
+        echo
+    fi
     if [ -s "$dir/failures.txt" ]; then
         echo "**Programs that failed** (their tables below are missing or partial; the error is in the run's output):"
         echo

@@ -32,18 +32,35 @@ export SHADOWLAB_MODEL_PATH="${SHADOWLAB_MODEL_PATH:-$(pwd)/../shared/models}"
 out=reports/bench
 quick=${QUICK:-0}
 mkdir -p "$out" || exit 1
-rm -f "$out"/*.csv "$out"/*.dat "$out"/*.gp "$out"/*.svg "$out"/*.png "$out"/README.md "$out"/failures.txt "$out"/complete.txt
+rm -f "$out"/*.csv "$out"/*.dat "$out"/*.gp "$out"/*.svg "$out"/*.png "$out"/README.md "$out"/failures.txt "$out"/complete.txt \
+    "$out"/steps.txt
 uptime > "$out/load.txt"
 failures=0
 current=
 
-step() { current=$1; echo; echo "== $* (load: $(cut -d' ' -f1-3 /proc/loadavg))"; }
+# step N TITLE: closes the previous step with its wall time (steps.txt, and the log), opens the next.
+step_start=
+step_close() {
+    [ -n "$step_start" ] || return 0
+    secs=$(( $(date +%s) - step_start ))
+    echo "  step $current in all: $secs s" >> "$out/steps.txt"
+    echo "-- step $current took $secs s"
+}
+step() {
+    step_close; current=$1; step_start=$(date +%s)
+    echo "step $*" >> "$out/steps.txt"
+    echo; echo "== $* (load: $(cut -d' ' -f1-3 /proc/loadavg))"
+}
 
 # run PROGRAM ARGS...: a failure is reported and recorded, and the run goes on.
 # stdout line-buffered, so a program's errors land between its lines, not in them.
+# Each program's wall time goes to steps.txt under its step.
 run() {
-    stdbuf -oL "$@" && return 0
+    t0=$(date +%s)
+    stdbuf -oL "$@"
     rc=$?
+    echo "  $(( $(date +%s) - t0 )) s: $*" | sed "s|$bin/||" >> "$out/steps.txt"
+    [ "$rc" -eq 0 ] && return 0
     failures=$((failures + 1))
     echo "run.sh: step $current: FAILED (exit $rc): $*" >&2
     echo "step $current: exit $rc: $*" >> "$out/failures.txt"
@@ -117,6 +134,7 @@ for s in scenes/bunny.lua scenes/sphere-on-plane.lua scenes/overlap.lua; do
     run "$bin/techniques" --only matched $q --samples "$samples" --threads "$threads" --repeat "$repeat" -o "$out" "$s"
 done
 
+step_close
 uptime >> "$out/load.txt"
 current=report
 start=$(date +%s.%N)
