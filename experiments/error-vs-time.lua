@@ -62,9 +62,7 @@ end
 
 local function main_parameter(t)
   local name = MAIN[t.name] or t.main
-  for _, p in ipairs(t.params) do
-    if p.name == name then return p end
-  end
+  return name and t.param[name]
 end
 
 -- Why some scene of the experiment refuses technique t at params (nil: none

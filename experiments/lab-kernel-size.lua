@@ -48,15 +48,14 @@ exp:scene("scenes/sphere-on-plane.lua", sweep.grid{ ["lights[1].radius"] = { 0.1
 
 local with_k = 0
 for _, t in ipairs(sl.techniques()) do
-  for _, p in ipairs(t.params) do
-    if p.name == "K" and (chosen.all or chosen[t.name]) then
-      local ks = {}
-      for _, k in ipairs(KERNELS) do
-        if k >= p.min and k <= p.max then ks[#ks + 1] = k end
-      end
-      exp:add(t.name, sweep.grid{ K = ks })
-      with_k = with_k + 1
+  local p = t.param.K
+  if p and (chosen.all or chosen[t.name]) then
+    local ks = {}
+    for _, k in ipairs(KERNELS) do
+      if k >= p.min and k <= p.max then ks[#ks + 1] = k end
     end
+    exp:add(t.name, sweep.grid{ K = ks })
+    with_k = with_k + 1
   end
 end
 if with_k == 0 then

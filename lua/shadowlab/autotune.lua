@@ -15,10 +15,7 @@ local autotune = {}
 local compare_fields = { "light", "repeats", "warmup", "samples", "pattern", "seed", "cache" }
 
 local function find_param(desc, name)
-  for _, p in ipairs(desc.params) do
-    if p.name == name then return p end
-  end
-  error(string.format("autotune: %s has no parameter %s", desc.name, name), 3)
+  return desc.param[name] or error(string.format("autotune: %s has no parameter %s", desc.name, name), 3)
 end
 
 -- The tuned parameters: the named ones (enums and bools step through their
@@ -39,9 +36,7 @@ end
 function autotune.default_params(desc)
   local names = {}
   if desc.main then names[#names + 1] = desc.main end
-  for _, p in ipairs(desc.params) do
-    if p.name == "map_size" and desc.main ~= "map_size" then names[#names + 1] = "map_size" end
-  end
+  if desc.param.map_size and desc.main ~= "map_size" then names[#names + 1] = "map_size" end
   if #names > 0 then return names end
   for _, p in ipairs(desc.params) do
     if p.type == "int" or p.type == "float" then names[#names + 1] = p.name end

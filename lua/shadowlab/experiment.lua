@@ -464,13 +464,6 @@ local function refuse_mixed_builds(o, writer, mine)
   end
 end
 
-local function has_param(desc, key)
-  for _, p in ipairs(desc.params) do
-    if p.name == key then return true end
-  end
-  return false
-end
-
 -- --param (parse_args's o.params) for the techniques named: {name = {key =
 -- value}}, each name's values checked against the registry's ranges. An
 -- unknown technique, or a --param that no technique named has, is an error.
@@ -485,7 +478,7 @@ function experiment.fixed_params(fixed, names)
     end
     local used = false
     for _, name in ipairs(names) do
-      if (f.technique == nil or f.technique == name) and has_param(sl.technique(name), f.key) then
+      if (f.technique == nil or f.technique == name) and sl.technique(name).param[f.key] then
         by_name[name] = by_name[name] or {}
         by_name[name][f.key] = f.value
         local ok, err = pcall(sl.params, name, by_name[name])

@@ -143,10 +143,7 @@ function sweep.latin(ranges, n, seed) return sample(ranges, n, seed, true) end
 function sweep.ranges_of(technique, names)
   local ranges = {}
   for _, name in ipairs(names) do
-    local found
-    for _, p in ipairs(technique.params) do
-      if p.name == name then found = p end
-    end
+    local found = technique.param[name]
     if not found then error(string.format("sweep.ranges_of: %s has no parameter %s", technique.name, name), 2) end
     if found.type ~= "int" and found.type ~= "float" then
       error(string.format("sweep.ranges_of: %s.%s is a %s, not a number", technique.name, name, found.type), 2)

@@ -79,7 +79,10 @@ void sl_push_technique(lua_State *L, const Technique *t)
     lua_setfield(L, -2, "lights");
     push_string_list(L, t->resources);
     lua_setfield(L, -2, "resources");
+    /* params: the list in registry order; param: the same tables by name
+       (desc.param.K), the one lookup every script uses. */
     lua_createtable(L, t->num_params, 0);
+    lua_createtable(L, 0, t->num_params);
     for (int i = 0, n = 0; i < t->num_params; i++) {
         if (!tech_param_offered(t, i)) continue; /* not the technique's (registry.h) */
         push_param(L, &t->params[i]);
@@ -87,8 +90,11 @@ void sl_push_technique(lua_State *L, const Technique *t)
             lua_pushstring(L, tech_param_when(t, i));
             lua_setfield(L, -2, "acts_when"); /* nil: always */
         }
-        lua_rawseti(L, -2, ++n);
+        lua_pushvalue(L, -1);
+        lua_setfield(L, -3, t->params[i].name);
+        lua_rawseti(L, -3, ++n);
     }
+    lua_setfield(L, -3, "param");
     lua_setfield(L, -2, "params");
 }
 

@@ -107,6 +107,18 @@ test("sweep_random_stays_in_range_and_ranges_come_from_the_registry", function()
   expect_error(function() sweep.ranges_of(hard, { "nope" }) end, "nope")
 end)
 
+test("technique_param_by_name_is_the_params_list_entry", function()
+  for _, t in ipairs(sl.techniques()) do
+    local named = 0
+    for _ in pairs(t.param) do named = named + 1 end
+    assert(named == #t.params, string.format("%s: %d parameters by name, %d in the list", t.name, named, #t.params))
+    for _, p in ipairs(t.params) do
+      assert(rawequal(t.param[p.name], p), t.name .. ".param." .. p.name .. " is not its params entry")
+    end
+  end
+  assert(sl.technique("hard").param.K == nil, "hard has no K")
+end)
+
 test("sweep_random_gives_every_integer_of_a_range_equal_weight", function()
   -- 40,000 draws over [1, 4]: each value 10,000 +- 4 sigma (sigma = sqrt(40000 * 1/4 * 3/4) = 86.6);
   -- rounding to the nearest gave the endpoints half weight (about 6,650 each).
