@@ -10,8 +10,11 @@
  *     against triangle count (the scene's objects[2].segments) and against
  *     image size (camera.width x camera.height at 4:3); --quick: one of
  *     these four axes a technique, rotating with its registry index
- *     (growth_axis), maps up to 1024^2, and a point's builds and evaluations
- *     each stop once they took GROWTH_QUICK_BUDGET_S;
+ *     (growth_axis), maps up to 1024^2 on the map_size axis and at most
+ *     GROWTH_QUICK_MAP_SIZE^2 on the others (a larger default lowered, the
+ *     row's settings saying so), the main parameter from 1/4 to 2 times its
+ *     default, and a point's builds and evaluations each stop once they took
+ *     GROWTH_QUICK_BUDGET_S;
  *   constant: techniques with a summed-area-table prefilter (a `prefilter`
  *     choice named sat) at K = its minimum and maximum: frame time at the
  *     largest K within 1.2x of the smallest (the papers' claim);
@@ -72,6 +75,12 @@
  * this long (lab.h RenderTiming; a 1024^2 cssm moment map builds in about 2 s
  * and was built 4 times a point: the growth step took 11 of QUICK's minutes). */
 #define GROWTH_QUICK_BUDGET_S 1.0
+/* --quick: the largest map the main parameter, triangle and image axes build
+ * (a default above it is lowered unless -p map_size is given): on 1024^2
+ * cube maps at one thread, cssm's 33-image summed-area tables took 13 s a
+ * point on the triangle axis, lvsm's 16 layers 15 s (growth: 288 s of the
+ * 19-minute QUICK run). */
+#define GROWTH_QUICK_MAP_SIZE 512
 
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup,cpu_ms_1,cpu_ms_n,busiest_ms_n,cpu_bound,evals," WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
@@ -305,14 +314,15 @@ static bool measure(Lab *lab, const Technique *t, const double *params, int repe
 /* The main knob the technique declares in the registry (-1: none). */
 static int main_param(const Technique *t) { return t->main_param ? tech_param_index(t, t->main_param) : -1; }
 
-/* Values of a parameter: its default times 1/4 ... 8, clamped to its range,
- * without repeats (ints rounded, odd where the default is: kernel widths). */
-static int param_values(const ParamDesc *p, double *v)
+/* Values of a parameter: its default times 1/4 ... 8 (--quick: ... 2),
+ * clamped to its range, without repeats (ints rounded, odd where the default
+ * is: kernel widths). */
+static int param_values(const ParamDesc *p, bool quick, double *v)
 {
     static const double factors[] = {0.25, 0.5, 1.0, 2.0, 4.0, 8.0};
-    int n = 0;
+    int n = 0, nf = quick ? 4 : 6;
     double def = p->def != 0.0 ? p->def : (p->min > 0.0 ? p->min : 1.0);
-    for (int k = 0; k < 6; k++) {
+    for (int k = 0; k < nf; k++) {
         double x = def * factors[k];
         if (p->type == PARAM_INT) {
             x = round(x);
@@ -403,8 +413,35 @@ static bool growth_axis(const Options *o, const Subject *sj, int a)
     return k == a;
 }
 
-static bool growth(const Options *o, Subject *sj, Error *err)
+/* Whether -p assigned the parameter `name` (a part then leaves it as given). */
+static bool assigned(const Options *o, const char *name)
 {
+    for (int i = 0; i < o->num_settings; i++)
+        if (strcmp(param_name(o->settings[i]).s, name) == 0) return true;
+    return false;
+}
+
+/* With --quick, on an axis other than map_size, sj's map_size lowered to
+ * GROWTH_QUICK_MAP_SIZE where its default is larger and -p map_size did not
+ * set it, the lowering added to its settings: those axes are curves in their
+ * own value, and the map's build was most of a point's time. */
+static void quick_map_size(const Options *o, Subject *sj)
+{
+    int ms = tech_param_index(sj->t, "map_size");
+    if (!o->quick || ms < 0 || growth_axis(o, sj, AXIS_MAP) || assigned(o, "map_size") ||
+        sj->params[ms] <= GROWTH_QUICK_MAP_SIZE)
+        return;
+    sj->params[ms] = GROWTH_QUICK_MAP_SIZE;
+    if (strcmp(sj->settings, "defaults") == 0) sj->settings[0] = '\0';
+    size_t used = strlen(sj->settings);
+    snprintf(sj->settings + used, sizeof sj->settings - used, "%smap_size=%d (--quick)", used ? " " : "",
+             GROWTH_QUICK_MAP_SIZE);
+}
+
+static bool growth(const Options *o, Subject *given, Error *err)
+{
+    Subject quick = *given, *sj = &quick;
+    quick_map_size(o, sj);
     static const int maps[] = {256, 512, 1024, 2048, 4096}, segs[] = {24, 96, 256, 512, 1024};
     static const int widths[] = {160, 320, 640, 1280};
     int nq = o->quick ? 3 : 5;
@@ -416,7 +453,7 @@ static bool growth(const Options *o, Subject *sj, Error *err)
     int mp = main_param(sj->t), ms = tech_param_index(sj->t, "map_size");
     if (mp >= 0 && growth_axis(o, sj, AXIS_MAIN)) {
         double v[MAX_POINTS];
-        ok = growth_param(o, lab, sj, mp, v, param_values(&sj->t->params[mp], v), err);
+        ok = growth_param(o, lab, sj, mp, v, param_values(&sj->t->params[mp], o->quick, v), err);
     }
     if (ok && ms >= 0 && growth_axis(o, sj, AXIS_MAP)) {
         double v[5];
@@ -429,6 +466,7 @@ static bool growth(const Options *o, Subject *sj, Error *err)
         ok = growth_scene(o, sj, "triangles", "objects[2].segments=%d", segs, nq, err);
     if (ok && growth_axis(o, sj, AXIS_IMAGE))
         ok = growth_scene(o, sj, "image_width", "camera.width=%d", widths, o->quick ? 3 : 4, err);
+    given->refused = sj->refused;
     return ok;
 }
 
@@ -517,14 +555,6 @@ static bool timed_rounds(Lab *const *labs, const Technique *t, double (*params)[
 static bool soft_on_spheres(const Technique *t)
 {
     return strcmp(t->family, "soft") == 0 && (t->lights & LIGHT_BIT(LIGHT_SPHERE));
-}
-
-/* Whether -p assigned the parameter `name` (a part then leaves it as given). */
-static bool assigned(const Options *o, const char *name)
-{
-    for (int i = 0; i < o->num_settings; i++)
-        if (strcmp(param_name(o->settings[i]).s, name) == 0) return true;
-    return false;
 }
 
 /* The two radii's times at map_size `map_size` (0: the technique has none),
@@ -1048,23 +1078,29 @@ static bool work_counts(const Options *o, Subject *sj, Error *err)
 
 /* ---- main ------------------------------------------------------------------ */
 
-/* The parts of one technique that --only asks for; its error printed. */
+/* The parts of one technique that --only asks for; its error printed, and
+ * its wall time where a part ran (where a step's minutes go). */
 static bool bench_technique(const Options *o, const Technique *t)
 {
     Subject sj;
     Error err;
-    bool ok = subject_init(o, t, &sj, &err);
-    if (ok && part(o, "growth")) ok = growth(o, &sj, &err);
-    if (ok && part(o, "constant") && has_sat(t)) ok = constant_time(o, &sj, &err);
-    if (ok && part(o, "threads")) ok = scaling(o, &sj, &err);
-    if (ok && part(o, "lightsize") && soft_on_spheres(t)) ok = light_size(o, &sj, &err);
-    if (ok && part(o, "work")) ok = work_counts(o, &sj, &err);
-    if (ok && o->only && strcmp(o->only, "sweep") == 0 && (sweep_on_scene(o) || tech_param_index(t, o->axis) >= 0))
-        ok = sweep_cost(o, &sj, &err);
-    if (ok && o->only && strcmp(o->only, "matched") == 0 && (o->num_techs > 0 || in_matched_family(t->name)))
-        ok = matched(o, &sj, &err);
+    double t0 = timer_now_s();
+    bool ok = subject_init(o, t, &sj, &err), ran = false;
+#define BENCH_PART(cond, call) \
+    if (ok && (cond)) ok = (ran = true, call)
+    BENCH_PART(part(o, "growth"), growth(o, &sj, &err));
+    BENCH_PART(part(o, "constant") && has_sat(t), constant_time(o, &sj, &err));
+    BENCH_PART(part(o, "threads"), scaling(o, &sj, &err));
+    BENCH_PART(part(o, "lightsize") && soft_on_spheres(t), light_size(o, &sj, &err));
+    BENCH_PART(part(o, "work"), work_counts(o, &sj, &err));
+    BENCH_PART(o->only && strcmp(o->only, "sweep") == 0 && (sweep_on_scene(o) || tech_param_index(t, o->axis) >= 0),
+               sweep_cost(o, &sj, &err));
+    BENCH_PART(o->only && strcmp(o->only, "matched") == 0 && (o->num_techs > 0 || in_matched_family(t->name)),
+               matched(o, &sj, &err));
+#undef BENCH_PART
     if (sj.refused) printf("%s: %d growth point(s) REFUSED (growth.csv's note column says why)\n", t->name, sj.refused);
     if (!ok) fprintf(stderr, "techniques: %s: FAILED: %s\n", t->name, err.msg);
+    if (ran) printf("%s: %.1f s wall, builds included\n", t->name, timer_now_s() - t0);
     return ok;
 }
 
