@@ -71,15 +71,14 @@ end
 local args = experiment.parse_args(arg, extra)
 
 -- A knob's text as the value its parameter takes (int, float or enum name).
-local param_type, param_default = {}, {}
-for _, p in ipairs(sl.technique("aliasing").params) do param_type[p.name], param_default[p.name] = p.type, p.default end
+local param = sl.technique("aliasing").param
 local function number_of(name, text)
   local v = tonumber(text)
   if not v then error(string.format("lab-aliasing: --%s expects a number, got '%s'", name, text), 0) end
   return v
 end
 local function param_value(knob, text)
-  local t = param_type[knob.param]
+  local t = param[knob.param].type
   if t == "int" then return math.tointeger(number_of(knob[1], text)) or number_of(knob[1], text) end
   if t == "float" then return number_of(knob[1], text) end
   return text
@@ -100,7 +99,7 @@ local function map_params(values)
   for _, k in ipairs(KNOBS) do
     if k.param then
       local v = param_value(k, values[k[1]])
-      local d = param_default[k.param]
+      local d = param[k.param].default
       if (type(v) == "number" and type(d) == "number" and v ~= d) or (type(v) ~= "number" and tostring(v) ~= tostring(d)) then
         p[k.param] = v
       end
