@@ -66,11 +66,18 @@ run() {
     echo "step $current: exit $rc: $*" >> "$out/failures.txt"
 }
 
-if [ "$quick" = 1 ]; then res="--res 1024 --res 2048"; q=--quick; else res="--res 1024 --res 2048 --res 4096"; q=; fi
+# QUICK: two map sizes, growth's and threads' maps lowered (techniques.c), and the
+# reference against bare Embree at half the light samples (its rows say which).
+if [ "$quick" = 1 ]; then
+    res="--res 1024 --res 2048"; q=--quick; ref_samples=$((samples / 2))
+else
+    res="--res 1024 --res 2048 --res 4096"; q=; ref_samples=$samples
+fi
+[ "$ref_samples" -ge 1 ] || ref_samples=1
 
 step 1 "reference against a bare Embree loop"
 for s in scenes/sphere-on-plane.lua scenes/bunny.lua; do
-    run "$bin/bare_embree" "$s" -n "$samples" --threads "$threads" --repeat "$repeat" -o "$out/reference_throughput.csv"
+    run "$bin/bare_embree" "$s" -n "$ref_samples" --threads "$threads" --repeat "$repeat" -o "$out/reference_throughput.csv"
 done
 run "$bin/single_sample_overhead" --radius 0.05 --radius 0.4 --threads "$threads" --repeat "$repeat" -o "$out" \
     scenes/sphere-on-plane.lua scenes/bunny.lua
@@ -100,12 +107,12 @@ run "$bin/sweep_reuse" --threads "$threads" -o "$out"
 
 step 5 "thread scaling, 1 2 4 ... $threads threads"
 for s in scenes/sphere-on-plane.lua scenes/bunny.lua; do
-    run "$bin/bare_embree" "$s" -n "$samples" --threads "$threads" --repeat "$repeat" --scaling \
+    run "$bin/bare_embree" "$s" -n "$ref_samples" --threads "$threads" --repeat "$repeat" --scaling \
         -o "$out/reference_scaling.csv"
 done
 run "$bin/raster_threads" --res 2048 --threads "$threads" --repeat "$repeat" -o "$out" scenes/bunny.lua scenes/million.lua
 for kib in 256 4096; do run "$bin/coherence" --kib "$kib" --repeat 9 -o "$out"; done
-run "$bin/techniques" --only threads --threads "$threads" --repeat "$repeat" -o "$out"
+run "$bin/techniques" --only threads $q --threads "$threads" --repeat "$repeat" -o "$out"
 
 step 6 "peak memory against the resources' bytes, 4096^2 maps"
 run "$bin/memory" --res 4096 --threads "$threads" -o "$out"

@@ -11,15 +11,17 @@
  *     image size (camera.width x camera.height at 4:3); --quick: one of
  *     these four axes a technique, rotating with its registry index
  *     (growth_axis), maps up to 1024^2 on the map_size axis and at most
- *     GROWTH_QUICK_MAP_SIZE^2 on the others (a larger default lowered, the
+ *     QUICK_MAP_SIZE^2 on the others (a larger default lowered, the
  *     row's settings saying so), the main parameter from 1/4 to 2 times its
- *     default, and a point's builds and evaluations each stop once they took
+ *     default (an enum or bool main parameter: each of its choices, the row's
+ *     value its index), and a point's builds and evaluations each stop once they took
  *     GROWTH_QUICK_BUDGET_S;
  *   constant: techniques with a summed-area-table prefilter (a `prefilter`
  *     choice named sat) at K = its minimum and maximum: frame time at the
  *     largest K within 1.2x of the smallest (the papers' claim);
  *   threads: each technique's evaluation, and the Embree reference, on the
- *     curve 1, 2, 4, ... N threads (bench.h's BenchCurve), with the CPU time
+ *     curve 1, 2, 4, ... N threads (bench.h's BenchCurve; --quick: maps of
+ *     at most QUICK_MAP_SIZE^2, a larger default lowered), with the CPU time
  *     a technique's threads ran (lab.h's eval_cpu_s, eval_busiest_s); a
  *     point's time is the median of as many evaluations as take about
  *     SCALING_MIN_S at one thread (the count fixed in the warm-up round), so
@@ -75,12 +77,14 @@
  * this long (lab.h RenderTiming; a 1024^2 cssm moment map builds in about 2 s
  * and was built 4 times a point: the growth step took 11 of QUICK's minutes). */
 #define GROWTH_QUICK_BUDGET_S 1.0
-/* --quick: the largest map the main parameter, triangle and image axes build
- * (a default above it is lowered unless -p map_size is given): on 1024^2
- * cube maps at one thread, cssm's 33-image summed-area tables took 13 s a
- * point on the triangle axis, lvsm's 16 layers 15 s (growth: 288 s of the
- * 19-minute QUICK run). */
-#define GROWTH_QUICK_MAP_SIZE 512
+/* --quick: the largest map growth's main parameter, triangle and image axes
+ * and the threads part build (a default above it is lowered unless -p
+ * map_size is given): on 1024^2 cube maps at one thread, cssm's 33-image
+ * summed-area tables took 13 s a growth point on the triangle axis, lvsm's
+ * 16 layers 15 s (growth: 288 s of the 19-minute QUICK run); threads' builds
+ * at 640 x 480 took most of its 233 s (penumbra_deep_map's 1024^2 cube: 11 s
+ * of its 25, where the evaluations are 0.05 s each). */
+#define QUICK_MAP_SIZE 512
 
 #define THREADS_HEADER "technique,ms_1,ms_n,speedup,cpu_ms_1,cpu_ms_n,busiest_ms_n,cpu_bound,evals," WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
@@ -314,13 +318,19 @@ static bool measure(Lab *lab, const Technique *t, const double *params, int repe
 /* The main knob the technique declares in the registry (-1: none). */
 static int main_param(const Technique *t) { return t->main_param ? tech_param_index(t, t->main_param) : -1; }
 
-/* Values of a parameter: its default times 1/4 ... 8 (--quick: ... 2),
- * clamped to its range, without repeats (ints rounded, odd where the default
- * is: kernel widths). */
+/* Values of a parameter: an enum's or a bool's every choice (at most
+ * MAX_POINTS); a number's default times 1/4 ... 8 (--quick: ... 2), clamped
+ * to its range, without repeats (ints rounded, odd where the default is:
+ * kernel widths). */
 static int param_values(const ParamDesc *p, bool quick, double *v)
 {
+    int n = 0;
+    if (p->type == PARAM_ENUM || p->type == PARAM_BOOL) {
+        for (double x = p->min; x <= p->max && n < MAX_POINTS; x += 1.0) v[n++] = x;
+        return n;
+    }
     static const double factors[] = {0.25, 0.5, 1.0, 2.0, 4.0, 8.0};
-    int n = 0, nf = quick ? 4 : 6;
+    int nf = quick ? 4 : 6;
     double def = p->def != 0.0 ? p->def : (p->min > 0.0 ? p->min : 1.0);
     for (int k = 0; k < nf; k++) {
         double x = def * factors[k];
@@ -421,27 +431,24 @@ static bool assigned(const Options *o, const char *name)
     return false;
 }
 
-/* With --quick, on an axis other than map_size, sj's map_size lowered to
- * GROWTH_QUICK_MAP_SIZE where its default is larger and -p map_size did not
- * set it, the lowering added to its settings: those axes are curves in their
- * own value, and the map's build was most of a point's time. */
-static void quick_map_size(const Options *o, Subject *sj)
+/* sj's map_size lowered to `size` where it is larger and -p map_size did
+ * not set it, the lowering added to its settings ("map_size=N (--quick)"). */
+static void lower_map_size(const Options *o, Subject *sj, int size)
 {
     int ms = tech_param_index(sj->t, "map_size");
-    if (!o->quick || ms < 0 || growth_axis(o, sj, AXIS_MAP) || assigned(o, "map_size") ||
-        sj->params[ms] <= GROWTH_QUICK_MAP_SIZE)
-        return;
-    sj->params[ms] = GROWTH_QUICK_MAP_SIZE;
+    if (ms < 0 || assigned(o, "map_size") || sj->params[ms] <= size) return;
+    sj->params[ms] = size;
     if (strcmp(sj->settings, "defaults") == 0) sj->settings[0] = '\0';
     size_t used = strlen(sj->settings);
-    snprintf(sj->settings + used, sizeof sj->settings - used, "%smap_size=%d (--quick)", used ? " " : "",
-             GROWTH_QUICK_MAP_SIZE);
+    snprintf(sj->settings + used, sizeof sj->settings - used, "%smap_size=%d (--quick)", used ? " " : "", size);
 }
 
 static bool growth(const Options *o, Subject *given, Error *err)
 {
     Subject quick = *given, *sj = &quick;
-    quick_map_size(o, sj);
+    /* --quick: the axes other than map_size are curves in their own value,
+     * and the map's build was most of a point's time */
+    if (o->quick && !growth_axis(o, sj, AXIS_MAP)) lower_map_size(o, sj, QUICK_MAP_SIZE);
     static const int maps[] = {256, 512, 1024, 2048, 4096}, segs[] = {24, 96, 256, 512, 1024};
     static const int widths[] = {160, 320, 640, 1280};
     int nq = o->quick ? 3 : 5;
@@ -993,8 +1000,10 @@ static bool scaling_rows(const Options *o, const Scaling *s, const BenchCurve *c
 }
 
 /* The subject's (or the reference's, sj->t NULL) curve at 640 x 480. */
-static bool scaling(const Options *o, Subject *sj, Error *err)
+static bool scaling(const Options *o, Subject *given, Error *err)
 {
+    Subject quick = *given, *sj = &quick;
+    if (sj->t && o->quick) lower_map_size(o, sj, QUICK_MAP_SIZE); /* the curve is the evaluation's */
     const char *ov[] = {"camera.width=640", "camera.height=480"};
     Scaling s = {.sj = sj};
     if (sj->t) s.lab = open_lab(o, sj, ov, 2, err);
