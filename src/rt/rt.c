@@ -2,7 +2,6 @@
  * with RTC_SCENE_FLAG_ROBUST (watertight traversal: a ground truth must not
  * leak light through shared edges) and high build quality. */
 #include "rt/rt.h"
-#include <float.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -111,8 +110,3 @@ int rt_scene_object(const RtScene *rs, unsigned geom_id)
     return geom_id < (unsigned)rs->num_geoms ? rs->object_of_geom[geom_id] : -1;
 }
 
-float rt_ray_offset(float scene_extent, vec3 p)
-{
-    /* 1e-5 of the extent, plus ~128 ulps of the point's largest coordinate. */
-    return 1e-5f * scene_extent + 128.0f * FLT_EPSILON * v3_maxabs(p);
-}

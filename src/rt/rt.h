@@ -5,6 +5,8 @@
 #ifndef SL_RT_H
 #define SL_RT_H
 #include <embree3/rtcore.h>
+#include <float.h>
+#include <math.h>
 #include <stddef.h>
 #include "core/counters.h"
 #include "scene/scene.h"
@@ -30,8 +32,19 @@ int rt_scene_object(const RtScene *rs, unsigned geom_id);
 
 /* Offset (world units) along the geometric normal that lifts a ray origin off
  * the surface it was found on: scaled to the scene's extent and to the
- * point's magnitude, since float error of a hit point grows with both. */
-float rt_ray_offset(float scene_extent, vec3 p_world);
+ * point's magnitude, since float error of a hit point grows with both:
+ * 1e-5 of the extent, plus ~128 ulps of the point's largest coordinate.
+ * Inline, with its maximum in comparisons (not fmaxf, a libm call here), so
+ * a loop over samples runs it in vector lanes (smap.c's batched set-up). A
+ * NaN coordinate may or may not reach the offset; the point it lifts is NaN
+ * either way, and stays NaN (every consumer tests the lifted point). */
+static inline float rt_ray_offset(float scene_extent, vec3 p_world)
+{
+    float ax = fabsf(p_world.x), ay = fabsf(p_world.y), az = fabsf(p_world.z);
+    float m = ax > ay ? ax : ay;
+    m = m > az ? m : az;
+    return 1e-5f * scene_extent + 128.0f * FLT_EPSILON * m;
+}
 
 /* Embree's ray calls, counted (counters.h: one call, and the rays it
  * traces). Every ray the lab traces goes through these. */

@@ -295,15 +295,18 @@ static void locate_batch(const FaceF *f, int n, BatchF *b)
 static void batch_locate(const FaceF *f, const SmapBias *b, const vec3 *p_world, const vec3 *n_geom_world,
                          const int *index, int n, BatchF *B)
 {
-    for (int k = 0; k < n; k++) {
+    for (int k = 0; k < n; k++) { /* gathered into lanes, then lifted in them */
         vec3 p = p_world[index[k]], nrm = n_geom_world[index[k]];
-        float lift = rt_ray_offset(b->scene_extent, p);
-        B->nx[k] = nrm.x;
-        B->ny[k] = nrm.y;
-        B->nz[k] = nrm.z;
-        B->x[k] = p.x + nrm.x * lift;
-        B->y[k] = p.y + nrm.y * lift;
-        B->z[k] = p.z + nrm.z * lift;
+        B->x[k] = p.x, B->y[k] = p.y, B->z[k] = p.z;
+        B->nx[k] = nrm.x, B->ny[k] = nrm.y, B->nz[k] = nrm.z;
+    }
+    float extent = b->scene_extent;
+#pragma omp simd
+    for (int k = 0; k < n; k++) {
+        float lift = rt_ray_offset(extent, v3(B->x[k], B->y[k], B->z[k]));
+        B->x[k] += B->nx[k] * lift;
+        B->y[k] += B->ny[k] * lift;
+        B->z[k] += B->nz[k] * lift;
     }
     locate_batch(f, n, B);
     if (b->normal_offset_texels > 0.0) {
