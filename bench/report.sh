@@ -80,6 +80,7 @@ sweep_reuse.csv             sweep technique points threads | sweep_ms:a- ratio:r
 reference_scaling.csv       scene rays threads | reference_ms_n:a- reference_speedup:r+ ratio:r+
 raster_threads.csv          scene res threads | ms_n:a- speedup:r+
 coherence.csv               kib | handover_ns:a- other_over_own:r-
+cpu_speed.csv               label loop cpu | alone_ms:a- dynamic_bound:r+ static_bound:r+
 threads_eval.csv            technique threads light settings width height | ms_n:a- speedup:r+
 memory.csv                  technique map_res light | peak_rss_mib:a- ratio:r-
 startup.csv                 command | first_line_ms:a- exit_ms:a-
@@ -481,6 +482,10 @@ trap 'rm -f "$cmp" "$gone" "$sum" "$md.tmp$$"' EXIT
     table reference_scaling.csv scene rays threads bare_ms_1 bare_ms_n bare_speedup reference_ms_1 reference_ms_n reference_speedup ratio within load_1min
     table raster_threads.csv scene triangles res threads ms_1 ms_n speedup load_1min
     table coherence.csv kib handover_ns own_ns_per_line other_ns_per_line other_over_own load_1min
+    echo "The machine's own bound on the speed-ups above and below (cpu_speed.c: fixed loops on each CPU alone and"
+    echo "all at once, before the rasterizer's curve and after the techniques'); a speed-up reads against it:"
+    echo
+    table cpu_speed.csv label loop cpu alone_ms together_ms alone_over_median together_over_alone dynamic_bound static_bound load_1min
     table threads_eval.csv technique threads ms_1 ms_n speedup cpu_ms_1 cpu_ms_n cpu_bound light width height load_1min
     echo "## 6. Peak memory, 4096^2 maps (target <= 1.2)"
     echo

@@ -110,9 +110,11 @@ for s in scenes/sphere-on-plane.lua scenes/bunny.lua; do
     run "$bin/bare_embree" "$s" -n "$ref_samples" --threads "$threads" --repeat "$repeat" --scaling \
         -o "$out/reference_scaling.csv"
 done
+run "$bin/cpu_speed" --label before --threads "$threads" -o "$out"
 run "$bin/raster_threads" --res 2048 --threads "$threads" --repeat "$repeat" -o "$out" scenes/bunny.lua scenes/million.lua
 for kib in 256 4096; do run "$bin/coherence" --kib "$kib" --repeat 9 -o "$out"; done
 run "$bin/techniques" --only threads $q --threads "$threads" --repeat "$repeat" -o "$out"
+run "$bin/cpu_speed" --label after --threads "$threads" -o "$out"
 
 step 6 "peak memory against the resources' bytes, 4096^2 maps"
 run "$bin/memory" --res 4096 --threads "$threads" -o "$out"
