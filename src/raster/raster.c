@@ -12,15 +12,21 @@
  * 16384^2), evaluated in int64. */
 #include "raster/raster.h"
 #include <omp.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include "raster/clip.h"
 #include "core/array.h"
 #include "core/counters.h"
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #define SUB (1 << RASTER_SUBPIXEL_BITS) /* sub-texel steps per texel */
 #define HALF (SUB / 2)                  /* texel centre offset */
 #define TILE 64                          /* texels per tile side */
+#define CACHE_LINE 64                    /* bytes */
+#define STREAM_MIN_BYTES ((size_t)32 << 20) /* maps larger (4096^2 floats) are stored around the caches (row_store) */
 #define CHUNK_TRIANGLES 4096             /* triangles per set-up chunk (at most 4 chunks per thread) */
 /* Triangles ahead whose data is fetched early: a mesh's index order jumps
  * around its vertex array, and a tile's bin around the triangle array. */
@@ -61,6 +67,7 @@ typedef struct Setup {
     const RasterOptions *opt;
     ValueMode mode;
     int width, height, tiles_x, tiles_y;
+    bool stream; /* row_store's non-temporal stores */
 } Setup;
 
 static long floor_div(long a, long b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
@@ -68,14 +75,19 @@ static long floor_div(long a, long b) { return a >= 0 ? a / b : -((-a + b - 1) /
 static inline double dmin(double a, double b) { return a < b ? a : b; }
 static inline double dmax(double a, double b) { return a > b ? a : b; }
 
+/* Memory starting on a cache line (and a whole number of them): tiles
+ * filled by different threads share no line when a map row's tile spans
+ * start on one (TILE floats are four lines). */
+static void *lines_alloc(size_t bytes) { return aligned_alloc(CACHE_LINE, (bytes + CACHE_LINE - 1) / CACHE_LINE * CACHE_LINE); }
+
 bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids, Error *err)
 {
     memset(db, 0, sizeof *db);
     if (width < 1 || height < 1 || width > RASTER_MAX_SIZE || height > RASTER_MAX_SIZE)
         return error_set(err, "depth map %dx%d outside [1, %d] per side", width, height, RASTER_MAX_SIZE);
     size_t n = (size_t)width * (size_t)height;
-    db->depth = malloc(n * sizeof *db->depth);
-    if (triangle_ids) db->triangle = malloc(n * sizeof *db->triangle);
+    db->depth = lines_alloc(n * sizeof *db->depth);
+    if (triangle_ids) db->triangle = lines_alloc(n * sizeof *db->triangle);
     if (!db->depth || (triangle_ids && !db->triangle)) {
         depth_buffer_free(db);
         return error_set(err, "out of memory for a %dx%d depth map (%.0f MiB)", width, height,
@@ -597,6 +609,30 @@ static void quantise(float *d, size_t n, int bits, double lo, double hi)
     }
 }
 
+/* A finished tile row into the map: n floats from src to dst, with
+ * non-temporal stores where `stream` (a map over the last-level cache: the
+ * lines go to memory without being read first) and dst is 16-byte aligned. */
+static void row_store(float *dst, const float *src, int n, bool stream)
+{
+#if defined(__SSE2__)
+    if (stream && ((uintptr_t)dst & 15) == 0) {
+        int i = 0;
+        for (; i + 4 <= n; i += 4) _mm_stream_ps(dst + i, _mm_loadu_ps(src + i));
+        for (; i < n; i++) dst[i] = src[i];
+        return;
+    }
+#endif
+    memcpy(dst, src, sizeof *dst * (size_t)n);
+}
+
+/* Non-temporal stores before are visible before any store after. */
+static void store_fence(void)
+{
+#if defined(__SSE2__)
+    _mm_sfence();
+#endif
+}
+
 static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, const int *bin_start, DepthBuffer *db,
                       long *overflow)
 {
@@ -613,7 +649,8 @@ static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, cons
     float empty = T.farthest ? -INFINITY : INFINITY;
     bool fast = !T.farthest && !T.id && !T.peel && !T.conservative && !counting; /* fill_small's case */
     int n = ti1 - ti0 + 1;
-    for (int i = 0; !counting && i < TILE * TILE; i++) local[i] = empty;
+    bool unbinned = bin_start[tile] == bin_start[tile + 1]; /* no triangle: one empty row stored to every row */
+    for (int i = 0; !counting && i < (unbinned ? TILE : TILE * TILE); i++) local[i] = empty;
     for (int j = tj0; db->triangle && j <= tj1; j++) {
         int32_t *id = db->triangle + (size_t)j * s->width + ti0;
         for (int i = 0; i < n; i++) id[i] = -1;
@@ -634,10 +671,11 @@ static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, cons
     double lo = opt->depth == RASTER_DEPTH_NDC ? 0.0 : s->view->depth_near;
     double hi = opt->depth == RASTER_DEPTH_NDC ? 1.0 : s->view->depth_far;
     for (int j = tj0; j <= tj1; j++) {
-        float *row = tile_row(&T, j, ti0);
-        if (quantised) quantise(row, (size_t)n, opt->depth_bits, lo, hi);
-        memcpy(db->depth + (size_t)j * s->width + ti0, row, sizeof *row * (size_t)n);
+        float *row = unbinned ? local : tile_row(&T, j, ti0);
+        if (quantised && !unbinned) quantise(row, (size_t)n, opt->depth_bits, lo, hi);
+        row_store(db->depth + (size_t)j * s->width + ti0, row, n, s->stream);
     }
+    if (s->stream) store_fence();
     return written;
 }
 
@@ -738,7 +776,7 @@ static long bin_and_fill(const Setup *s, RasterScratch *sc, int nchunks, DepthBu
 #pragma omp barrier
 #pragma omp for schedule(dynamic, 1)
         for (int k = 0; k < nchunks; k++) bin_chunk(s, &tt[k], cursor + (size_t)k * ntiles, bins);
-#pragma omp for schedule(dynamic, 1)
+#pragma omp for schedule(static, 1)
         for (int tile = 0; tile < ntiles; tile++) written += fill_tile(s, tile, bins, bin_start, db, &refused);
     }
     *overflow = refused;
@@ -808,7 +846,7 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
 {
     if (!check_inputs(meshes, num_meshes, view, opt, db, err)) return false;
     Setup s = {view, opt, value_mode(view, opt), db->width, db->height, (db->width + TILE - 1) / TILE,
-               (db->height + TILE - 1) / TILE};
+               (db->height + TILE - 1) / TILE, (size_t)db->width * (size_t)db->height * sizeof(float) > STREAM_MIN_BYTES};
     long total = 0;
     for (int m = 0; m < num_meshes; m++) total += meshes[m].num_triangles;
     /* More chunks than threads: set-up takes them in contiguous blocks (a
