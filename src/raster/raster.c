@@ -25,7 +25,6 @@
 #define SUB (1 << RASTER_SUBPIXEL_BITS) /* sub-texel steps per texel */
 #define HALF (SUB / 2)                  /* texel centre offset */
 #define TILE 64                          /* texels per tile side */
-#define CACHE_LINE 64                    /* bytes */
 #define STREAM_MIN_BYTES ((size_t)32 << 20) /* maps larger (4096^2 floats) are stored around the caches (row_store) */
 #define CHUNK_TRIANGLES 4096             /* triangles per set-up chunk (at most 4 chunks per thread) */
 /* Triangles ahead whose data is fetched early: a mesh's index order jumps
@@ -75,10 +74,10 @@ static long floor_div(long a, long b) { return a >= 0 ? a / b : -((-a + b - 1) /
 static inline double dmin(double a, double b) { return a < b ? a : b; }
 static inline double dmax(double a, double b) { return a > b ? a : b; }
 
-/* Memory starting on a cache line (and a whole number of them): tiles
- * filled by different threads share no line when a map row's tile spans
- * start on one (TILE floats are four lines). */
-static void *lines_alloc(size_t bytes) { return aligned_alloc(CACHE_LINE, (bytes + CACHE_LINE - 1) / CACHE_LINE * CACHE_LINE); }
+void *raster_map_alloc(size_t bytes)
+{
+    return aligned_alloc(RASTER_CACHE_LINE, (bytes + RASTER_CACHE_LINE - 1) / RASTER_CACHE_LINE * RASTER_CACHE_LINE);
+}
 
 bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids, Error *err)
 {
@@ -86,8 +85,8 @@ bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids
     if (width < 1 || height < 1 || width > RASTER_MAX_SIZE || height > RASTER_MAX_SIZE)
         return error_set(err, "depth map %dx%d outside [1, %d] per side", width, height, RASTER_MAX_SIZE);
     size_t n = (size_t)width * (size_t)height;
-    db->depth = lines_alloc(n * sizeof *db->depth);
-    if (triangle_ids) db->triangle = lines_alloc(n * sizeof *db->triangle);
+    db->depth = raster_map_alloc(n * sizeof *db->depth);
+    if (triangle_ids) db->triangle = raster_map_alloc(n * sizeof *db->triangle);
     if (!db->depth || (triangle_ids && !db->triangle)) {
         depth_buffer_free(db);
         return error_set(err, "out of memory for a %dx%d depth map (%.0f MiB)", width, height,

@@ -19,6 +19,7 @@
  * (Everitt & Kilgard 2002). */
 #ifndef SL_RASTER_H
 #define SL_RASTER_H
+#include <stddef.h>
 #include <stdint.h>
 #include "core/error.h"
 #include "core/mat4.h"
@@ -120,6 +121,13 @@ typedef struct RasterStats {
     long texels_written;
 } RasterStats;
 
+#define RASTER_CACHE_LINE 64 /* bytes */
+
+/* Map memory (free()d as usual) starting on a cache line and a whole number
+ * of lines long: the tiles that different threads fill share no line when
+ * a map row's tile spans start on one (a tile row is four lines). Every
+ * map the rasterizer fills comes from here. */
+void *raster_map_alloc(size_t bytes);
 bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids, Error *err);
 void depth_buffer_free(DepthBuffer *db);
 void raster_scratch_free(RasterScratch *scratch);

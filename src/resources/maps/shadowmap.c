@@ -173,8 +173,8 @@ static ShadowMap *map_alloc(const ShadowMapSpec *spec, uint64_t key, const Light
     m->res = spec->res;
     m->num_faces = m->view.num_faces;
     size_t texels = (size_t)m->num_faces * (size_t)m->res * (size_t)m->res;
-    m->depth = malloc(texels * sizeof *m->depth);
-    if (spec->triangle_ids) m->triangle = malloc(texels * sizeof *m->triangle);
+    m->depth = raster_map_alloc(texels * sizeof *m->depth);
+    if (spec->triangle_ids) m->triangle = raster_map_alloc(texels * sizeof *m->triangle);
     if (!m->depth || (spec->triangle_ids && !m->triangle)) {
         error_set(err, "out of memory for a %d-face %d^2 shadow map", m->num_faces, m->res);
         shadowmap_free(m);
