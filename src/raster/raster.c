@@ -609,8 +609,11 @@ static void quantise(float *d, size_t n, int bits, double lo, double hi)
 }
 
 /* A finished tile row into the map: n floats from src to dst, with
- * non-temporal stores where `stream` (a map over the last-level cache: the
- * lines go to memory without being read first) and dst is 16-byte aligned. */
+ * non-temporal stores where `stream` (a map over STREAM_MIN_BYTES, more than
+ * a core complex's last-level cache on most CPUs: the lines go to memory
+ * without being read first) and dst is 16-byte aligned. The same for the
+ * set-up triangles (SnapTri) measured slower at every size (bench/README.md,
+ * step 9). */
 static void row_store(float *dst, const float *src, int n, bool stream)
 {
 #if defined(__SSE2__)
