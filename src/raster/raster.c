@@ -25,7 +25,6 @@
 #define SUB (1 << RASTER_SUBPIXEL_BITS) /* sub-texel steps per texel */
 #define HALF (SUB / 2)                  /* texel centre offset */
 #define TILE 64                          /* texels per tile side */
-#define STREAM_MIN_BYTES ((size_t)32 << 20) /* maps larger (4096^2 floats) are stored around the caches (row_store) */
 #define CHUNK_TRIANGLES 4096             /* triangles per set-up chunk (at most 4 chunks per thread) */
 /* Triangles ahead whose data is fetched early: a mesh's index order jumps
  * around its vertex array, and a tile's bin around the triangle array. */
@@ -609,7 +608,7 @@ static void quantise(float *d, size_t n, int bits, double lo, double hi)
 }
 
 /* A finished tile row into the map: n floats from src to dst, with
- * non-temporal stores where `stream` (a map over STREAM_MIN_BYTES, more than
+ * non-temporal stores where `stream` (a map over RASTER_STREAM_MIN_BYTES, more than
  * a core complex's last-level cache on most CPUs: the lines go to memory
  * without being read first) and dst is 16-byte aligned. The same for the
  * set-up triangles (SnapTri) measured slower at every size (bench/README.md,
@@ -848,7 +847,7 @@ bool raster_depth(const RasterMesh *meshes, int num_meshes, const RasterView *vi
 {
     if (!check_inputs(meshes, num_meshes, view, opt, db, err)) return false;
     Setup s = {view, opt, value_mode(view, opt), db->width, db->height, (db->width + TILE - 1) / TILE,
-               (db->height + TILE - 1) / TILE, (size_t)db->width * (size_t)db->height * sizeof(float) > STREAM_MIN_BYTES};
+               (db->height + TILE - 1) / TILE, (size_t)db->width * (size_t)db->height * sizeof(float) > RASTER_STREAM_MIN_BYTES};
     long total = 0;
     for (int m = 0; m < num_meshes; m++) total += meshes[m].num_triangles;
     /* More chunks than threads: set-up takes them in contiguous blocks (a

@@ -122,6 +122,7 @@ typedef struct RasterStats {
 } RasterStats;
 
 #define RASTER_CACHE_LINE 64 /* bytes */
+#define RASTER_STREAM_MIN_BYTES ((size_t)32 << 20) /* maps larger (4096^2 floats) are stored around the caches */
 
 /* Map memory (free()d as usual) starting on a cache line and a whole number
  * of lines long: the tiles that different threads fill share no line when

@@ -135,6 +135,39 @@ TEST(test_raster_reused_scratch_renders_like_a_fresh_buffer)
     grid_free(&large);
 }
 
+/* A map over RASTER_STREAM_MIN_BYTES is stored around the caches
+ * (raster.c's row_store): a 4097 x 2100 map (34 MB), whose rows start on
+ * 16 bytes only every fourth row (the others take the plain copy) and
+ * whose last tile column is one texel wide, holds the square
+ * [-0.5, 0.5]^2 at depth 10 exactly where the texel centres fall inside
+ * it (none lies within a quarter texel of its edges), +inf elsewhere. */
+TEST(test_raster_streamed_large_map_holds_the_square_exactly)
+{
+    enum { W = 4097, H = 2100 };
+    CHECK((size_t)W * H * sizeof(float) > RASTER_STREAM_MIN_BYTES);
+    Grid g = grid_make(2, -0.5f, -0.5f, 0.5f, 0.0f);
+    RasterView v = overhead_ortho();
+    RasterOptions opt = {0};
+    DepthBuffer db;
+    Error err;
+    CHECK(depth_buffer_init(&db, W, H, false, &err));
+    CHECK(raster_depth(&g.mesh, 1, &v, &opt, &db, NULL, &err));
+    long wrong = 0, inside = 0;
+    for (int j = 0; j < H; j++)
+        for (int i = 0; i < W; i++) {
+            double u = -1.0 + (i + 0.5) * 2.0 / W, w = -1.0 + (j + 0.5) * 2.0 / H; /* texel centre, map [-1, 1]^2 */
+            bool in = u > -0.5 && u < 0.5 && w > -0.5 && w < 0.5;
+            float d = db.depth[(size_t)j * W + i];
+            inside += in;
+            wrong += in ? !(fabsf(d - 10.0f) < 1e-5f) : !(isinf(d) && d > 0.0f);
+        }
+    printf("    %ld texels inside, %ld wrong\n", inside, wrong);
+    CHECK(inside == 2049L * 1050L);
+    CHECK_MSG(wrong == 0, "%ld texels of the streamed map wrong", wrong);
+    depth_buffer_free(&db);
+    grid_free(&g);
+}
+
 /* Triangle order survives the parallel set-up and binning: the same grid
  * twice, coplanar (every fragment ties), split into several set-up chunks;
  * ties keep the first fragment, so every texel holds the first copy's
