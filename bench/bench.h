@@ -51,6 +51,16 @@ int bench_fail(const char *program, const Error *err);
 /* Median of n values (n >= 1; sorts a copy). */
 double bench_median(const double *v, int n);
 
+/* The machine's own speed, a loop of four independent multiply-add chains
+ * in registers (no memory; about 1.7 ns an iteration on this AMD EPYC):
+ * seconds for `iters` iterations on the calling thread. */
+double bench_spin_s(long iters);
+/* The same work, `iters` iterations in all, split evenly over the current
+ * OpenMP threads: its speed-up from 1 to N threads is what the machine
+ * gives N busy threads at that moment (cpu_speed.c, and the control side
+ * of techniques' curves). Seconds of wall time. */
+double bench_spin_parallel_s(long iters);
+
 /* One round of a two-sided comparison: the seconds of side a and side b. */
 typedef bool (*BenchPairFn)(void *run, double *a_s, double *b_s, Error *err);
 /* An untimed warm-up round, then `repeat` rounds; med = {median of a,

@@ -4,7 +4,7 @@
  * a shared VM the vCPUs do not keep one speed: one can run at half the
  * other's for minutes, which a 1-thread run landing on the fast one reads as
  * poor scaling, and on the slow one as a superlinear speed-up.
- *   compute: four independent multiply-add chains in registers (no memory:
+ *   compute: bench_spin_s, four multiply-add chains in registers (no memory:
  *     the cores' own speed);
  *   stream: a read of a private STREAM_MIB MiB buffer (each thread its own,
  *     far over the caches: the memory bandwidth the CPUs share);
@@ -48,25 +48,8 @@ static int own_option(void *options, const char *a, const char *v)
     return 2;
 }
 
-/* The loop's result, written so the loop stays. */
-volatile double spin_result;
-
-/* The compute loop (milliseconds): four independent chains x = x a + b,
- * held in registers. */
-static double spin_ms(void)
-{
-    double x0 = 1.0, x1 = 1.1, x2 = 1.2, x3 = 1.3, a = 0.999999, b = 1e-7;
-    double t0 = timer_now_s();
-    for (long i = 0; i < SPIN_ITERS; i++) {
-        x0 = x0 * a + b;
-        x1 = x1 * a + b;
-        x2 = x2 * a + b;
-        x3 = x3 * a + b;
-    }
-    double ms = (timer_now_s() - t0) * 1e3;
-    spin_result = x0 + x1 + x2 + x3;
-    return ms;
-}
+/* The stream loop's result, written so the loop stays. */
+static volatile double stream_result;
 
 /* The stream loop (milliseconds): STREAM_PASSES reads of buf, four sums. */
 static double stream_ms(const double *buf)
@@ -82,7 +65,7 @@ static double stream_ms(const double *buf)
             s3 += buf[i + 3];
         }
     double ms = (timer_now_s() - t0) * 1e3;
-    spin_result = s0 + s1 + s2 + s3;
+    stream_result = s0 + s1 + s2 + s3;
     return ms;
 }
 
@@ -90,7 +73,10 @@ enum { LOOP_COMPUTE, LOOP_STREAM, NUM_LOOPS };
 static const char *const loop_name[NUM_LOOPS] = {"compute", "stream"};
 
 /* One run of loop `loop` on the calling thread (buf: its stream buffer). */
-static double run_loop(int loop, const double *buf) { return loop == LOOP_COMPUTE ? spin_ms() : stream_ms(buf); }
+static double run_loop(int loop, const double *buf)
+{
+    return loop == LOOP_COMPUTE ? bench_spin_s(SPIN_ITERS) * 1e3 : stream_ms(buf);
+}
 
 /* Pin the calling thread to CPU c; false where the system refuses. */
 static bool pin(int c)
@@ -178,7 +164,7 @@ int main(int argc, char **argv)
     }
     Error err = {0};
     if (!ok) error_set(&err, "out of memory (%d x %d MiB)", n, STREAM_MIB);
-    spin_ms(); /* warm-up: the clock ramps, the threads start */
+    bench_spin_s(SPIN_ITERS); /* warm-up: the clock ramps, the threads start */
     for (int loop = 0; ok && loop < NUM_LOOPS; loop++) ok = measure_loop(&o, loop, bufs, t, &err);
     if (!ok) fprintf(stderr, "cpu_speed: %s\n", err.msg);
     for (int c = 0; c < n; c++) free(bufs[c]);

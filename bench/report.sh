@@ -312,6 +312,12 @@ plot x with lines dashtype 2 title 'ideal'"
                 > "$dir/threads_$t.dat"
             script="$script, '$dir/threads_$t.dat' using 1:2 with linespoints title '$t'"
         done
+        # the curves' control loop (techniques.c), the median over techniques per thread count
+        column "$dir/threads_eval.csv" threads machine_speedup | sort -k1,1n -k2,2g |
+            awk 'NF == 2 && $2 != "" { if ($1 != t && n) { print t, m[int((n + 1) / 2)]; n = 0 } t = $1; m[++n] = $2 }
+                 END { if (n) print t, m[int((n + 1) / 2)] }' > "$dir/threads_machine.dat"
+        [ -s "$dir/threads_machine.dat" ] &&
+            script="$script, '$dir/threads_machine.dat' using 1:2 with linespoints lw 3 dashtype 3 title 'machine (control loop)'"
         if [ -f "$dir/reference_scaling.csv" ]; then
             for s in $(column "$dir/reference_scaling.csv" scene | sort -u); do
                 column "$dir/reference_scaling.csv" scene threads bare_speedup |
@@ -486,7 +492,7 @@ trap 'rm -f "$cmp" "$gone" "$sum" "$md.tmp$$"' EXIT
     echo "all at once, before the rasterizer's curve and after the techniques'); a speed-up reads against it:"
     echo
     table cpu_speed.csv label loop cpu alone_ms together_ms alone_over_median together_over_alone dynamic_bound static_bound load_1min
-    table threads_eval.csv technique threads ms_1 ms_n speedup cpu_ms_1 cpu_ms_n cpu_bound light width height load_1min
+    table threads_eval.csv technique threads ms_1 ms_n speedup machine_speedup over_machine cpu_ms_1 cpu_ms_n cpu_bound light width height load_1min
     echo "## 6. Peak memory, 4096^2 maps (target <= 1.2)"
     echo
     table memory.csv technique map_res peak_rss_mib resources_mib ratio within baseline_rss_mib note light load_1min

@@ -86,7 +86,8 @@
  * of its 25, where the evaluations are 0.05 s each). */
 #define QUICK_MAP_SIZE 512
 
-#define THREADS_HEADER "technique,ms_1,ms_n,speedup,cpu_ms_1,cpu_ms_n,busiest_ms_n,cpu_bound,evals," WHERE_HEADER
+#define THREADS_HEADER "technique,ms_1,ms_n,speedup,cpu_ms_1,cpu_ms_n,busiest_ms_n,cpu_bound,machine_speedup,over_machine,evals," \
+                       WHERE_HEADER
 #define LIGHT_SIZE_HEADER "technique,map_size,radius_small,radius_large,frame_small_ms,frame_large_ms,ratio,bound,within," \
                           "eval_small_ms,eval_large_ms,eval_ratio,bytes_small,bytes_large,bytes_ratio,note," \
                           WHERE_HEADER
@@ -925,11 +926,21 @@ static int curve_point(const Scaling *s, int threads)
     return k;
 }
 
-/* One timed evaluation (or reference computation); BenchTimedFn. */
+/* The curves' control side: a fixed register-only loop split over the
+ * threads (bench_spin_parallel_s), about 10 ms on one thread, timed in the
+ * same rounds as the subject: its speed-up is what the machine gave that
+ * many busy threads at those moments, the bound beside the subject's. */
+#define CONTROL_SPIN_ITERS 6000000L
+enum { SIDE_SUBJECT, SIDE_CONTROL, NUM_SIDES };
+
+/* One timed evaluation (or reference computation), or the control; BenchTimedFn. */
 static bool scaled_once(void *ctx, int side, int threads, double *seconds, Error *err)
 {
     Scaling *s = ctx;
-    (void)side;
+    if (side == SIDE_CONTROL) {
+        *seconds = bench_spin_parallel_s(CONTROL_SPIN_ITERS);
+        return true;
+    }
     if (s->sj->t) {
         Point p;
         if (!measure(s->lab, s->sj->t, s->sj->params, s->repeat > 0 ? s->repeat : 1, &p, err)) return false;
@@ -980,16 +991,18 @@ static bool scaling_rows(const Options *o, const Scaling *s, const BenchCurve *c
 {
     const char *name = s->sj->t ? s->sj->t->name : "reference";
     bool ok = true;
-    double ms1 = bench_curve_median_s(c, 0, 0) * 1e3;
+    double ms1 = bench_curve_median_s(c, SIDE_SUBJECT, 0) * 1e3;
     printf("  %-18s 1 thread %9.3f ms (median of %d)", name, ms1, s->repeat > 0 ? s->repeat : 1);
     for (int k = 0; ok && k < c->points; k++) {
         char row[2048], end[1024], cpu[256];
-        double msk = bench_curve_median_s(c, 0, k) * 1e3, speedup = bench_curve_speedup(c, 0, k), bound;
+        double msk = bench_curve_median_s(c, SIDE_SUBJECT, k) * 1e3, speedup = bench_curve_speedup(c, SIDE_SUBJECT, k);
+        double machine = bench_curve_speedup(c, SIDE_CONTROL, k);
+        double over = bench_curve_relative(c, SIDE_SUBJECT, SIDE_CONTROL, k), bound;
         where(s->sj, lab_scene(s->lab), c->threads[k], end, sizeof end);
         cpu_columns(s, k, cpu, sizeof cpu, &bound);
-        snprintf(row, sizeof row, "%s,%.4f,%.4f,%.3f,%s,%d,%s", name, ms1, msk, speedup, cpu, s->repeat > 0 ? s->repeat : 1,
-                 end);
-        if (k > 0) printf("; %d: %.3f ms, speed-up %.2f", c->threads[k], msk, speedup);
+        snprintf(row, sizeof row, "%s,%.4f,%.4f,%.3f,%s,%.3f,%.3f,%d,%s", name, ms1, msk, speedup, cpu, machine, over,
+                 s->repeat > 0 ? s->repeat : 1, end);
+        if (k > 0) printf("; %d: %.3f ms, speed-up %.2f (machine %.2f)", c->threads[k], msk, speedup, machine);
         if (k > 0 && s->sj->t)
             printf(" (CPU bound %.2f, CPU %.2fx of 1 thread's)", bound,
                    cpu_median_ms(s, s->cpu, k) / cpu_median_ms(s, s->cpu, 0));
@@ -1012,7 +1025,7 @@ static bool scaling(const Options *o, Subject *given, Error *err)
     if (!sj->t) snprintf(sj->light.text, sizeof sj->light.text, "%s", light_kind_name(lab_scene(s.lab)->lights[0].kind));
     if (sj->t) announce(o, sj, "threads");
     BenchCurve c;
-    bool ok = bench_curve_init(&c, o->c.threads, 1, o->c.repeat, err);
+    bool ok = bench_curve_init(&c, o->c.threads, NUM_SIDES, o->c.repeat, err);
     size_t runs = ok ? (size_t)c.points * (size_t)(c.rounds + 1) : 0;
     s.c = &c;
     s.cpu = runs ? calloc(2 * runs, sizeof *s.cpu) : NULL;
