@@ -225,10 +225,7 @@ static bool parse_options(int argc, char **argv, Options *o)
 {
     *o = (Options){.quick = false, .samples = 64};
     if (!bench_parse(argc, argv, 3, &o->c, own_option, o) || o->c.num_scenes > 1) return false;
-    static const char *const parts[] = {"growth", "constant", "threads", "lightsize", "work", "sweep", "matched"};
-    bool known = !o->only;
-    for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++) known = known || strcmp(o->only, parts[i]) == 0;
-    if (!known || (o->only && strcmp(o->only, "sweep") == 0 && !o->sweep)) return false;
+    if (o->only && strcmp(o->only, "sweep") == 0 && !o->sweep) return false; /* --only's name: main, against PARTS */
     for (int i = 0; i < o->num_techs; i++) {
         Error err;
         if (strcmp(o->techs[i], "reference") == 0 || tech_find(o->techs[i], &err)) continue;
@@ -1100,6 +1097,53 @@ static bool work_counts(const Options *o, Subject *sj, Error *err)
 
 /* ---- main ------------------------------------------------------------------ */
 
+/* Which techniques a part measures (NULL in Part: every one). */
+static bool constant_applies(const Options *o, const Technique *t) { (void)o; return has_sat(t); }
+static bool lightsize_applies(const Options *o, const Technique *t) { (void)o; return soft_on_spheres(t); }
+static bool sweep_applies(const Options *o, const Technique *t)
+{
+    return sweep_on_scene(o) || tech_param_index(t, o->axis) >= 0;
+}
+static bool matched_applies(const Options *o, const Technique *t)
+{
+    return o->num_techs > 0 || in_matched_family(t->name);
+}
+
+/* The parts of the bench (--only NAME), in the order a technique runs them:
+ * each for the techniques `applies` admits; an `only_asked` part runs only
+ * when --only names it. */
+typedef struct Part {
+    const char *name;
+    bool only_asked;
+    bool (*applies)(const Options *o, const Technique *t);
+    bool (*run)(const Options *o, Subject *sj, Error *err);
+} Part;
+
+static const Part PARTS[] = {
+    {"growth", false, NULL, growth},
+    {"constant", false, constant_applies, constant_time},
+    {"threads", false, NULL, scaling},
+    {"lightsize", false, lightsize_applies, light_size},
+    {"work", false, NULL, work_counts},
+    {"sweep", true, sweep_applies, sweep_cost},
+    {"matched", true, matched_applies, matched},
+};
+#define NUM_PARTS (int)(sizeof PARTS / sizeof PARTS[0])
+
+static bool part_named(const char *name)
+{
+    for (int i = 0; i < NUM_PARTS; i++)
+        if (strcmp(PARTS[i].name, name) == 0) return true;
+    return false;
+}
+
+/* Whether part p runs for technique t. */
+static bool part_runs(const Options *o, const Part *p, const Technique *t)
+{
+    bool asked = p->only_asked ? o->only && strcmp(o->only, p->name) == 0 : part(o, p->name);
+    return asked && (!p->applies || p->applies(o, t));
+}
+
 /* The parts of one technique that --only asks for; its error printed, and
  * its wall time where a part ran (where a step's minutes go). */
 static bool bench_technique(const Options *o, const Technique *t)
@@ -1108,18 +1152,11 @@ static bool bench_technique(const Options *o, const Technique *t)
     Error err;
     double t0 = timer_now_s();
     bool ok = subject_init(o, t, &sj, &err), ran = false;
-#define BENCH_PART(cond, call) \
-    if (ok && (cond)) ok = (ran = true, call)
-    BENCH_PART(part(o, "growth"), growth(o, &sj, &err));
-    BENCH_PART(part(o, "constant") && has_sat(t), constant_time(o, &sj, &err));
-    BENCH_PART(part(o, "threads"), scaling(o, &sj, &err));
-    BENCH_PART(part(o, "lightsize") && soft_on_spheres(t), light_size(o, &sj, &err));
-    BENCH_PART(part(o, "work"), work_counts(o, &sj, &err));
-    BENCH_PART(o->only && strcmp(o->only, "sweep") == 0 && (sweep_on_scene(o) || tech_param_index(t, o->axis) >= 0),
-               sweep_cost(o, &sj, &err));
-    BENCH_PART(o->only && strcmp(o->only, "matched") == 0 && (o->num_techs > 0 || in_matched_family(t->name)),
-               matched(o, &sj, &err));
-#undef BENCH_PART
+    for (int i = 0; ok && i < NUM_PARTS; i++) {
+        if (!part_runs(o, &PARTS[i], t)) continue;
+        ran = true;
+        ok = PARTS[i].run(o, &sj, &err);
+    }
     if (sj.refused) printf("%s: %d growth point(s) REFUSED (growth.csv's note column says why)\n", t->name, sj.refused);
     if (!ok) fprintf(stderr, "techniques: %s: FAILED: %s\n", t->name, err.msg);
     if (ran) printf("%s: %.1f s wall, builds included\n", t->name, timer_now_s() - t0);
@@ -1129,10 +1166,16 @@ static bool bench_technique(const Options *o, const Technique *t)
 int main(int argc, char **argv)
 {
     Options o;
-    if (!parse_options(argc, argv, &o))
-        return bench_usage("techniques [--only growth|constant|threads|lightsize|work|sweep|matched] [-t TECH]... "
-                           "[-p NAME=VALUE]... [--sweep NAME=V1,V2,...] [--samples N] [--threads N] [--repeat R] "
-                           "[--quick] [-o DIR] [SCENE]");
+    if (!parse_options(argc, argv, &o) || (o.only && !part_named(o.only))) {
+        char usage[512] = "techniques [--only ";
+        for (int i = 0; i < NUM_PARTS; i++) {
+            strcat(usage, PARTS[i].name);
+            strcat(usage, i + 1 < NUM_PARTS ? "|" : "] ");
+        }
+        strcat(usage, "[-t TECH]... [-p NAME=VALUE]... [--sweep NAME=V1,V2,...] [--samples N] [--threads N] "
+                      "[--repeat R] [--quick] [-o DIR] [SCENE]");
+        return bench_usage(usage);
+    }
     omp_set_num_threads(o.c.threads);
     rt_set_threads(o.c.threads);
     int failed = 0, run = 0;
