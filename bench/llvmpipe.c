@@ -37,7 +37,8 @@
 #define DEPTH_TOLERANCE 1e-5 /* z_ndc: float32 transforms on one side, double on the other */
 
 #define DEPTH_HEADER                                                                                              \
-    "scene,triangles,res,llvmpipe_ms,shadowlab_ms,speedup,fill_ms,vs_fill,texels_covered,coverage_mismatch,"    \
+    "scene,triangles,res,llvmpipe_ms,shadowlab_ms,speedup,fill_ms,vs_fill,empty_ms,empty_vs_fill,texels_covered," \
+    "coverage_mismatch,"                                                                                          \
     "depth_mismatch,max_depth_diff,agree,renderer," BENCH_TAIL_HEADER "\n"
 #define PCF_HEADER                                                                                              \
     "scene,width,height,map_res,K,candidates,llvmpipe_ms,shadowlab_ms,speedup,mae,samples_off,agree,renderer," \
@@ -150,9 +151,12 @@ typedef struct DepthRun {
     DepthBuffer db;
     /* The memory-write limit, timed in the same rounds: the map's bytes
      * stored once by the same threads (fill), and per round shadowlab's
-     * time over it; round 0 is the warm-up. */
+     * time over it; and the rasterizer's own floor, a render of no
+     * triangles into a map of the same size (empty: every tile stores
+     * its empty rows), over the fill; round 0 is the warm-up. */
     float *fill;
-    double *fill_s, *vs_fill;
+    double *fill_s, *vs_fill, *empty_s, *empty_vs_fill;
+    DepthBuffer empty;
     int rounds, max_rounds;
 } DepthRun;
 
@@ -232,32 +236,40 @@ static bool depth_round(void *run, double *gl_s, double *ours_s, Error *err)
         ok = raster_depth(r->c->mesh, r->c->num_meshes, r->view, &r->opt, &r->db, &st, err);
         *ours_s = timer_now_s() - t0;
     }
-    double fill_s = 0.0;
+    double fill_s = 0.0, empty_s = 0.0;
     for (int k = 0; k < 2; k++) fill_s = fill_timed(r->fill, (size_t)r->db.width * r->db.height);
+    for (int k = 0; ok && k < 2; k++) {
+        double t0 = timer_now_s();
+        ok = raster_depth(NULL, 0, r->view, &r->opt, &r->empty, NULL, err);
+        empty_s = timer_now_s() - t0;
+    }
     if (r->rounds < r->max_rounds) {
         r->fill_s[r->rounds] = fill_s;
         r->vs_fill[r->rounds] = fill_s > 0.0 ? *ours_s / fill_s : INFINITY;
+        r->empty_s[r->rounds] = empty_s;
+        r->empty_vs_fill[r->rounds] = fill_s > 0.0 ? empty_s / fill_s : INFINITY;
         r->rounds++;
     }
     return ok && gl_check("the depth pass", err);
 }
 
 /* med: llvmpipe s, shadowlab s, their ratio; fill s, shadowlab / fill. */
-static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c, int res, const double med[5],
+static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c, int res, const double med[7],
                             const DepthAgreement *a, const char *renderer, Error *err)
 {
     char row[2048], tail[512], name[160], rend[300];
     bench_tail(tail, sizeof tail, o->c.threads);
     bench_csv_field(name, sizeof name, sc->name);
     bench_csv_field(rend, sizeof rend, renderer);
-    snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%ld,%ld,%ld,%.3g,%s,%s,%s\n", name, c->triangles,
-             res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[4], a->covered, a->coverage_mismatch,
+    snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%ld,%ld,%ld,%.3g,%s,%s,%s\n", name,
+             c->triangles, res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[4], med[5] * 1e3, med[6],
+             a->covered, a->coverage_mismatch,
              a->depth_mismatch, a->max_diff, depth_agrees(a) ? "yes" : "no", rend, tail);
     char path[4096];
     snprintf(path, sizeof path, "%s/llvmpipe_depth.csv", o->c.dir);
     printf("  depth %5d^2: llvmpipe %8.2f ms, shadowlab %8.2f ms, speed-up %.2fx; fill %.2f ms, shadowlab / fill "
-           "%.2f; coverage off %ld, depth off %ld of %ld (max %.2g)%s\n",
-           res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[4], a->coverage_mismatch, a->depth_mismatch,
+           "%.2f, no triangles / fill %.2f; coverage off %ld, depth off %ld of %ld (max %.2g)%s\n",
+           res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[4], med[6], a->coverage_mismatch, a->depth_mismatch,
            a->covered, a->max_diff, depth_agrees(a) ? "" : "  MISMATCH");
     return bench_csv_append(path, DEPTH_HEADER, row, err);
 }
@@ -266,8 +278,8 @@ static bool bench_depth(Lab *lab, const Casters *c, const GlContext *gl, const O
 {
     const ShadowMap *map = bench_map(lab, res, err);
     if (!map) return false;
-    DepthRun r = {c, NULL, &map->view.face[0].raster, {.depth = RASTER_DEPTH_NDC}, {0}, NULL, NULL, NULL, 0,
-                  o->c.repeat + 1};
+    DepthRun r = {.c = c, .view = &map->view.face[0].raster, .opt = {.depth = RASTER_DEPTH_NDC},
+                  .max_rounds = o->c.repeat + 1};
     GlTarget target;
     if (!gl_target_init(&target, res, res, GL_DEPTH_COMPONENT32F, err)) return false;
     r.target = &target;
@@ -275,12 +287,17 @@ static bool bench_depth(Lab *lab, const Casters *c, const GlContext *gl, const O
     r.fill = malloc(sizeof *r.fill * (size_t)res * res);
     r.fill_s = malloc(sizeof *r.fill_s * (size_t)r.max_rounds);
     r.vs_fill = malloc(sizeof *r.vs_fill * (size_t)r.max_rounds);
-    double med[5];
-    bool ok = (gl_depth && r.fill && r.fill_s && r.vs_fill) || error_set(err, "out of memory");
-    ok = ok && depth_buffer_init(&r.db, res, res, false, err) && bench_paired(depth_round, &r, o->c.repeat, med, err);
+    r.empty_s = malloc(sizeof *r.empty_s * (size_t)r.max_rounds);
+    r.empty_vs_fill = malloc(sizeof *r.empty_vs_fill * (size_t)r.max_rounds);
+    double med[7];
+    bool ok = (gl_depth && r.fill && r.fill_s && r.vs_fill && r.empty_s && r.empty_vs_fill) ||
+              error_set(err, "out of memory");
+    ok = ok && depth_buffer_init(&r.db, res, res, false, err) && depth_buffer_init(&r.empty, res, res, false, err) &&
+         bench_paired(depth_round, &r, o->c.repeat, med, err);
     if (ok) {
-        med[3] = r.rounds > 1 ? bench_median(r.fill_s + 1, r.rounds - 1) : NAN; /* round 0: the warm-up */
-        med[4] = r.rounds > 1 ? bench_median(r.vs_fill + 1, r.rounds - 1) : NAN;
+        const double *per_round[4] = {r.fill_s, r.vs_fill, r.empty_s, r.empty_vs_fill};
+        for (int k = 0; k < 4; k++) /* round 0: the warm-up */
+            med[3 + k] = r.rounds > 1 ? bench_median(per_round[k] + 1, r.rounds - 1) : NAN;
         glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
         glPixelStorei(GL_PACK_ALIGNMENT, 4);
         glReadPixels(0, 0, res, res, GL_DEPTH_COMPONENT, GL_FLOAT, gl_depth);
@@ -292,7 +309,10 @@ static bool bench_depth(Lab *lab, const Casters *c, const GlContext *gl, const O
     free(r.fill);
     free(r.fill_s);
     free(r.vs_fill);
+    free(r.empty_s);
+    free(r.empty_vs_fill);
     depth_buffer_free(&r.db);
+    depth_buffer_free(&r.empty);
     gl_target_free(&target);
     return ok;
 }
