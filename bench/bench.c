@@ -328,8 +328,9 @@ int bench_fail(const char *program, const Error *err)
     return 1;
 }
 
-/* The loop's result, written so the loop stays. */
-static volatile double spin_result;
+/* The loop's result, written so the loop stays (one per thread: the
+ * threads of bench_spin_parallel_s write it at once). */
+static _Thread_local volatile double spin_result;
 
 double bench_spin_s(long iters)
 {

@@ -48,8 +48,8 @@ static int own_option(void *options, const char *a, const char *v)
     return 2;
 }
 
-/* The stream loop's result, written so the loop stays. */
-static volatile double stream_result;
+/* The stream loop's result, written so the loop stays (one per thread: all write it at once). */
+static _Thread_local volatile double stream_result;
 
 /* The stream loop (milliseconds): STREAM_PASSES reads of buf, four sums. */
 static double stream_ms(const double *buf)

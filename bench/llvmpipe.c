@@ -221,28 +221,32 @@ static double fill_timed(float *d, size_t n)
     return s;
 }
 
+/* Two renders of `num_meshes` meshes into db back to back, the second
+ * timed (*s). */
+static bool raster_twice_timed(const DepthRun *r, const RasterMesh *meshes, int num_meshes, DepthBuffer *db, double *s,
+                               Error *err)
+{
+    bool ok = true;
+    for (int k = 0; ok && k < 2; k++) {
+        double t0 = timer_now_s();
+        ok = raster_depth(meshes, num_meshes, r->view, &r->opt, db, NULL, err);
+        *s = timer_now_s() - t0;
+    }
+    return ok;
+}
+
 /* One round: each side draws twice back to back and the second draw is
  * timed, so both run with warm caches and awake threads rather than
  * inheriting the other's cache state and sleeping worker pool; then the
- * fill of the map's bytes, the same way. */
+ * fill of the map's bytes and the render of no triangles, the same way. */
 static bool depth_round(void *run, double *gl_s, double *ours_s, Error *err)
 {
     DepthRun *r = run;
-    bool ok = true;
-    RasterStats st;
     for (int k = 0; k < 2; k++) *gl_s = gl_timed(gl_depth_draw, r);
-    for (int k = 0; ok && k < 2; k++) {
-        double t0 = timer_now_s();
-        ok = raster_depth(r->c->mesh, r->c->num_meshes, r->view, &r->opt, &r->db, &st, err);
-        *ours_s = timer_now_s() - t0;
-    }
+    bool ok = raster_twice_timed(r, r->c->mesh, r->c->num_meshes, &r->db, ours_s, err);
     double fill_s = 0.0, empty_s = 0.0;
     for (int k = 0; k < 2; k++) fill_s = fill_timed(r->fill, (size_t)r->db.width * r->db.height);
-    for (int k = 0; ok && k < 2; k++) {
-        double t0 = timer_now_s();
-        ok = raster_depth(NULL, 0, r->view, &r->opt, &r->empty, NULL, err);
-        empty_s = timer_now_s() - t0;
-    }
+    ok = ok && raster_twice_timed(r, NULL, 0, &r->empty, &empty_s, err);
     if (r->rounds < r->max_rounds) {
         r->fill_s[r->rounds] = fill_s;
         r->vs_fill[r->rounds] = fill_s > 0.0 ? *ours_s / fill_s : INFINITY;
@@ -253,7 +257,7 @@ static bool depth_round(void *run, double *gl_s, double *ours_s, Error *err)
     return ok && gl_check("the depth pass", err);
 }
 
-/* med: llvmpipe s, shadowlab s, their ratio; fill s, shadowlab / fill. */
+/* med: llvmpipe s, shadowlab s, their ratio; fill s, shadowlab / fill; no-triangle render s, it / fill. */
 static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c, int res, const double med[7],
                             const DepthAgreement *a, const char *renderer, Error *err)
 {

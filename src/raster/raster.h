@@ -126,8 +126,9 @@ typedef struct RasterStats {
 
 /* Map memory (free()d as usual) starting on a cache line and a whole number
  * of lines long: the tiles that different threads fill share no line when
- * a map row's tile spans start on one (a tile row is four lines). Every
- * map the rasterizer fills comes from here. */
+ * a map row's tile spans start on one (a tile row is four lines). Depth
+ * maps and triangle ids come from here (depth_buffer_init, the shadow-map
+ * resource); camera_count.c's counters are still calloc'd. */
 void *raster_map_alloc(size_t bytes);
 bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids, Error *err);
 void depth_buffer_free(DepthBuffer *db);
