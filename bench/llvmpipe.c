@@ -25,7 +25,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 #include "bench.h"
+#include "core/bufpool.h"
 #include "core/timer.h"
 #include "gl_context.h"
 
@@ -37,7 +41,8 @@
 #define DEPTH_TOLERANCE 1e-5 /* z_ndc: float32 transforms on one side, double on the other */
 
 #define DEPTH_HEADER                                                                                              \
-    "scene,triangles,res,llvmpipe_ms,shadowlab_ms,speedup,fill_ms,vs_fill,empty_ms,empty_vs_fill,texels_covered," \
+    "scene,triangles,res,llvmpipe_ms,shadowlab_ms,speedup,fill_ms,vs_fill,empty_ms,empty_vs_fill,store_fill_ms,"     \
+    "stream_fill_ms,texels_covered,"                                                                            \
     "coverage_mismatch,"                                                                                          \
     "depth_mismatch,max_depth_diff,agree,renderer," BENCH_TAIL_HEADER "\n"
 #define PCF_HEADER                                                                                              \
@@ -150,12 +155,14 @@ typedef struct DepthRun {
     RasterOptions opt;
     DepthBuffer db;
     /* The memory-write limit, timed in the same rounds: the map's bytes
-     * stored once by the same threads (fill), and per round shadowlab's
-     * time over it; and the rasterizer's own floor, a render of no
-     * triangles into a map of the same size (empty: every tile stores
-     * its empty rows), over the fill; round 0 is the warm-up. */
+     * stored once by the same threads, with ordinary stores (store_s) and
+     * with non-temporal ones (stream_s), the faster of the two the fill
+     * (fill_s), and per round shadowlab's time over it; and the
+     * rasterizer's own floor, a render of no triangles into a map of the
+     * same size (empty: every tile stores its empty rows), over the fill;
+     * round 0 is the warm-up. */
     float *fill;
-    double *fill_s, *vs_fill, *empty_s, *empty_vs_fill;
+    double *fill_s, *vs_fill, *empty_s, *empty_vs_fill, *store_s, *stream_s;
     DepthBuffer empty;
     int rounds, max_rounds;
 } DepthRun;
@@ -208,13 +215,29 @@ static bool depth_agrees(const DepthAgreement *a)
 }
 
 /* Every texel of a map stored once (the empty value, +INFINITY) by the
- * OpenMP threads, in the static split the compiler turns into vector
- * stores: what writing the map's bytes costs at the least. */
-static double fill_timed(float *d, size_t n)
+ * OpenMP threads in a static split: with ordinary stores, which the
+ * compiler turns into vector stores (each line is read for ownership
+ * first), or, where `stream`, with non-temporal ones (the lines go to
+ * memory unread, as the rasterizer stores maps over
+ * RASTER_STREAM_MIN_BYTES). The faster of the two is what writing the
+ * map's bytes costs at the least. d is on a cache line (bufpool_alloc);
+ * each thread's part starts on one. */
+static double fill_timed(float *d, size_t n, bool stream)
 {
     double t0 = timer_now_s();
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) d[i] = INFINITY;
+#pragma omp parallel
+    {
+        size_t nt = (size_t)omp_get_num_threads(), id = (size_t)omp_get_thread_num(), line = 16;
+        size_t lo = (n / line * id / nt) * line, hi = id + 1 == nt ? n : (n / line * (id + 1) / nt) * line, i = lo;
+#if defined(__SSE2__)
+        if (stream) {
+            __m128 empty = _mm_set1_ps(INFINITY);
+            for (; i + 4 <= hi; i += 4) _mm_stream_ps(d + i, empty);
+            _mm_sfence();
+        }
+#endif
+        for (; i < hi; i++) d[i] = INFINITY;
+    }
     double s = timer_now_s() - t0;
     volatile float keep = d[n / 2]; /* the stores are read: not dead */
     (void)keep;
@@ -244,10 +267,15 @@ static bool depth_round(void *run, double *gl_s, double *ours_s, Error *err)
     DepthRun *r = run;
     for (int k = 0; k < 2; k++) *gl_s = gl_timed(gl_depth_draw, r);
     bool ok = raster_twice_timed(r, r->c->mesh, r->c->num_meshes, &r->db, ours_s, err);
-    double fill_s = 0.0, empty_s = 0.0;
-    for (int k = 0; k < 2; k++) fill_s = fill_timed(r->fill, (size_t)r->db.width * r->db.height);
+    double store_s = 0.0, stream_s = 0.0, empty_s = 0.0;
+    size_t n = (size_t)r->db.width * r->db.height;
+    for (int k = 0; k < 2; k++) store_s = fill_timed(r->fill, n, false);
+    for (int k = 0; k < 2; k++) stream_s = fill_timed(r->fill, n, true);
+    double fill_s = store_s < stream_s ? store_s : stream_s;
     ok = ok && raster_twice_timed(r, NULL, 0, &r->empty, &empty_s, err);
     if (r->rounds < r->max_rounds) {
+        r->store_s[r->rounds] = store_s;
+        r->stream_s[r->rounds] = stream_s;
         r->fill_s[r->rounds] = fill_s;
         r->vs_fill[r->rounds] = fill_s > 0.0 ? *ours_s / fill_s : INFINITY;
         r->empty_s[r->rounds] = empty_s;
@@ -257,23 +285,26 @@ static bool depth_round(void *run, double *gl_s, double *ours_s, Error *err)
     return ok && gl_check("the depth pass", err);
 }
 
-/* med: llvmpipe s, shadowlab s, their ratio; fill s, shadowlab / fill; no-triangle render s, it / fill. */
-static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c, int res, const double med[7],
+/* med: llvmpipe s, shadowlab s, their ratio; fill s, shadowlab / fill; no-triangle render s, it / fill; the
+ * fill with ordinary and with non-temporal stores, s. */
+static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c, int res, const double med[9],
                             const DepthAgreement *a, const char *renderer, Error *err)
 {
     char row[2048], tail[512], name[160], rend[300];
     bench_tail(tail, sizeof tail, o->c.threads);
     bench_csv_field(name, sizeof name, sc->name);
     bench_csv_field(rend, sizeof rend, renderer);
-    snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%ld,%ld,%ld,%.3g,%s,%s,%s\n", name,
-             c->triangles, res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[4], med[5] * 1e3, med[6],
-             a->covered, a->coverage_mismatch,
+    snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%ld,%ld,%ld,%.3g,%s,%s,%s\n",
+             name, c->triangles, res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[4], med[5] * 1e3, med[6],
+             med[7] * 1e3, med[8] * 1e3, a->covered, a->coverage_mismatch,
              a->depth_mismatch, a->max_diff, depth_agrees(a) ? "yes" : "no", rend, tail);
     char path[4096];
     snprintf(path, sizeof path, "%s/llvmpipe_depth.csv", o->c.dir);
-    printf("  depth %5d^2: llvmpipe %8.2f ms, shadowlab %8.2f ms, speed-up %.2fx; fill %.2f ms, shadowlab / fill "
-           "%.2f, no triangles / fill %.2f; coverage off %ld, depth off %ld of %ld (max %.2g)%s\n",
-           res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[4], med[6], a->coverage_mismatch, a->depth_mismatch,
+    printf("  depth %5d^2: llvmpipe %8.2f ms, shadowlab %8.2f ms, speed-up %.2fx; fill %.2f ms (stores %.2f, "
+           "non-temporal %.2f), shadowlab / fill %.2f, no triangles / fill %.2f; coverage off %ld, depth off %ld of %ld "
+           "(max %.2g)%s\n",
+           res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[7] * 1e3, med[8] * 1e3, med[4], med[6],
+           a->coverage_mismatch, a->depth_mismatch,
            a->covered, a->max_diff, depth_agrees(a) ? "" : "  MISMATCH");
     return bench_csv_append(path, DEPTH_HEADER, row, err);
 }
@@ -288,19 +319,21 @@ static bool bench_depth(Lab *lab, const Casters *c, const GlContext *gl, const O
     if (!gl_target_init(&target, res, res, GL_DEPTH_COMPONENT32F, err)) return false;
     r.target = &target;
     float *gl_depth = malloc(sizeof *gl_depth * (size_t)res * res);
-    r.fill = malloc(sizeof *r.fill * (size_t)res * res);
+    r.fill = bufpool_alloc(sizeof *r.fill * (size_t)res * res);
     r.fill_s = malloc(sizeof *r.fill_s * (size_t)r.max_rounds);
     r.vs_fill = malloc(sizeof *r.vs_fill * (size_t)r.max_rounds);
     r.empty_s = malloc(sizeof *r.empty_s * (size_t)r.max_rounds);
     r.empty_vs_fill = malloc(sizeof *r.empty_vs_fill * (size_t)r.max_rounds);
-    double med[7];
-    bool ok = (gl_depth && r.fill && r.fill_s && r.vs_fill && r.empty_s && r.empty_vs_fill) ||
+    r.store_s = malloc(sizeof *r.store_s * (size_t)r.max_rounds);
+    r.stream_s = malloc(sizeof *r.stream_s * (size_t)r.max_rounds);
+    double med[9];
+    bool ok = (gl_depth && r.fill && r.fill_s && r.vs_fill && r.empty_s && r.empty_vs_fill && r.store_s && r.stream_s) ||
               error_set(err, "out of memory");
     ok = ok && depth_buffer_init(&r.db, res, res, false, err) && depth_buffer_init(&r.empty, res, res, false, err) &&
          bench_paired(depth_round, &r, o->c.repeat, med, err);
     if (ok) {
-        const double *per_round[4] = {r.fill_s, r.vs_fill, r.empty_s, r.empty_vs_fill};
-        for (int k = 0; k < 4; k++) /* round 0: the warm-up */
+        const double *per_round[6] = {r.fill_s, r.vs_fill, r.empty_s, r.empty_vs_fill, r.store_s, r.stream_s};
+        for (int k = 0; k < 6; k++) /* round 0: the warm-up */
             med[3 + k] = r.rounds > 1 ? bench_median(per_round[k] + 1, r.rounds - 1) : NAN;
         glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
         glPixelStorei(GL_PACK_ALIGNMENT, 4);
@@ -310,11 +343,13 @@ static bool bench_depth(Lab *lab, const Casters *c, const GlContext *gl, const O
              write_depth_row(o, lab_scene(lab), c, res, med, &a, gl_context_renderer(gl), err);
     }
     free(gl_depth);
-    free(r.fill);
+    bufpool_free(r.fill);
     free(r.fill_s);
     free(r.vs_fill);
     free(r.empty_s);
     free(r.empty_vs_fill);
+    free(r.store_s);
+    free(r.stream_s);
     depth_buffer_free(&r.db);
     depth_buffer_free(&r.empty);
     gl_target_free(&target);

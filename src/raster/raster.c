@@ -17,6 +17,7 @@
 #include <string.h>
 #include "raster/clip.h"
 #include "core/array.h"
+#include "core/bufpool.h"
 #include "core/counters.h"
 #if defined(__SSE2__)
 #include <immintrin.h>
@@ -73,19 +74,14 @@ static long floor_div(long a, long b) { return a >= 0 ? a / b : -((-a + b - 1) /
 static inline double dmin(double a, double b) { return a < b ? a : b; }
 static inline double dmax(double a, double b) { return a > b ? a : b; }
 
-void *raster_map_alloc(size_t bytes)
-{
-    return aligned_alloc(RASTER_CACHE_LINE, (bytes + RASTER_CACHE_LINE - 1) / RASTER_CACHE_LINE * RASTER_CACHE_LINE);
-}
-
 bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids, Error *err)
 {
     memset(db, 0, sizeof *db);
     if (width < 1 || height < 1 || width > RASTER_MAX_SIZE || height > RASTER_MAX_SIZE)
         return error_set(err, "depth map %dx%d outside [1, %d] per side", width, height, RASTER_MAX_SIZE);
     size_t n = (size_t)width * (size_t)height;
-    db->depth = raster_map_alloc(n * sizeof *db->depth);
-    if (triangle_ids) db->triangle = raster_map_alloc(n * sizeof *db->triangle);
+    db->depth = bufpool_alloc(n * sizeof *db->depth);
+    if (triangle_ids) db->triangle = bufpool_alloc(n * sizeof *db->triangle);
     if (!db->depth || (triangle_ids && !db->triangle)) {
         depth_buffer_free(db);
         return error_set(err, "out of memory for a %dx%d depth map (%.0f MiB)", width, height,
@@ -98,8 +94,8 @@ bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids
 
 void depth_buffer_free(DepthBuffer *db)
 {
-    free(db->depth);
-    free(db->triangle);
+    bufpool_free(db->depth);
+    bufpool_free(db->triangle);
     raster_scratch_free(db->scratch);
     memset(db, 0, sizeof *db);
 }

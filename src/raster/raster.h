@@ -121,15 +121,16 @@ typedef struct RasterStats {
     long texels_written;
 } RasterStats;
 
-#define RASTER_CACHE_LINE 64 /* bytes */
 #define RASTER_STREAM_MIN_BYTES ((size_t)32 << 20) /* maps larger (4096^2 floats) are stored around the caches */
 
-/* Map memory (free()d as usual) starting on a cache line and a whole number
- * of lines long: the tiles that different threads fill share no line when
- * a map row's tile spans start on one (a tile row is four lines). Depth
- * maps and triangle ids come from here (depth_buffer_init, the shadow-map
- * resource); camera_count.c's counters are still calloc'd. */
-void *raster_map_alloc(size_t bytes);
+/* Depth maps and triangle ids (depth_buffer_init's, the shadow-map
+ * resource's) come from core/bufpool.h: each starts on a cache line and is
+ * a whole number of lines long, so the tiles that different threads fill
+ * share no line when a map row's tile spans start on one (a tile row is
+ * four lines), and a map freed and allocated again at its size (the next
+ * build of a sweep or a frame) reuses its pages. Free them with
+ * bufpool_free (depth_buffer_free does). camera_count.c's counters are
+ * still calloc'd. */
 bool depth_buffer_init(DepthBuffer *db, int width, int height, bool triangle_ids, Error *err);
 void depth_buffer_free(DepthBuffer *db);
 void raster_scratch_free(RasterScratch *scratch);

@@ -305,13 +305,17 @@ int rm_log_count(const ResourceManager *rm) { return rm->log.n; }
 const ResourceEvent *rm_log_event(const ResourceManager *rm, int i) { return &rm->log.ev[i]; }
 void rm_log_reset(ResourceManager *rm) { rm->log.n = 0; }
 
+/* Once per event: a resource acquired again (every build of a scope's
+ * frame, every repeat) notes the same thing again. */
 void rm_log_note(ResourceManager *rm, const char *kind, uint64_t key, const char *note)
 {
+    char suffix[sizeof rm->log.ev[0].desc];
+    snprintf(suffix, sizeof suffix, " (%s)", note);
     for (int i = 0; i < rm->log.n; i++) {
         ResourceEvent *ev = &rm->log.ev[i];
-        if (ev->key != key || strcmp(ev->kind, kind) != 0) continue;
+        if (ev->key != key || strcmp(ev->kind, kind) != 0 || strstr(ev->desc, suffix)) continue;
         size_t n = strlen(ev->desc);
-        snprintf(ev->desc + n, sizeof ev->desc - n, " (%s)", note);
+        snprintf(ev->desc + n, sizeof ev->desc - n, "%s", suffix);
     }
 }
 

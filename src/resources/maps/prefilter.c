@@ -7,23 +7,27 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/bufpool.h"
 #include "core/counters.h"
 #include "core/hash.h"
 #include "core/nanmath.h"
 
 /* ---- element storage ---- */
 
+/* The prefiltered maps and min-max levels, like the depth maps they are made
+ * from, come from core/bufpool.h: rebuilt at the same size (a scope's
+ * repeated builds, a sweep, the next frame) they reuse their pages. */
 static bool store_alloc(PfStore *s, size_t n, bool f64)
 {
-    s->d = f64 ? malloc(n * sizeof *s->d) : NULL;
-    s->f = f64 ? NULL : malloc(n * sizeof *s->f);
+    s->d = f64 ? bufpool_alloc(n * sizeof *s->d) : NULL;
+    s->f = f64 ? NULL : bufpool_alloc(n * sizeof *s->f);
     return s->d || s->f;
 }
 
 static void store_free(PfStore *s)
 {
-    free(s->d);
-    free(s->f);
+    bufpool_free(s->d);
+    bufpool_free(s->f);
 }
 
 static inline void pf_put(PfStore *s, size_t i, double v)
@@ -626,7 +630,7 @@ bool pf_fetch_box(const Prefiltered *pf, int face, double s, double t, double hx
 static void pyramid_destroy(void *r)
 {
     MinMaxPyramid *p = r;
-    free(p->minmax);
+    bufpool_free(p->minmax);
     free(p);
 }
 
@@ -668,7 +672,7 @@ static void *build_pyramid(const void *args, Error *err)
         p->levels++;
         if (n == 1) break;
     }
-    p->minmax = malloc(pyramid_pairs(p) * 2 * sizeof *p->minmax);
+    p->minmax = bufpool_alloc(pyramid_pairs(p) * 2 * sizeof *p->minmax);
     if (!p->minmax) {
         free(p);
         error_set(err, "out of memory for a %d^2 min-max pyramid", m->res);
@@ -768,7 +772,7 @@ float minmax_node_min(const MinMaxPyramid *p, int face, int level, int *i, int *
 static void buffer_destroy(void *r)
 {
     MinMaxBuffer *b = r;
-    free(b->minmax);
+    bufpool_free(b->minmax);
     free(b);
 }
 
@@ -829,7 +833,7 @@ static void *build_buffer(const void *args, Error *err)
     const ShadowMap *m = a->map;
     size_t n = (size_t)m->num_faces * m->res * m->res;
     MinMaxBuffer *b = calloc(1, sizeof *b);
-    if (b) b->minmax = malloc(n * 2 * sizeof *b->minmax);
+    if (b) b->minmax = bufpool_alloc(n * 2 * sizeof *b->minmax);
     if (!b || !b->minmax) {
         if (b) buffer_destroy(b);
         error_set(err, "out of memory for a %d^2 min-max N-buffer", m->res);
@@ -892,7 +896,7 @@ static size_t levels_pairs(const MinMaxLevels *m) { return (size_t)m->levels * m
 static void levels_destroy(void *r)
 {
     MinMaxLevels *m = r;
-    free(m->minmax);
+    bufpool_free(m->minmax);
     free(m);
 }
 
@@ -919,10 +923,10 @@ static void *build_levels(const void *args, Error *err)
     if (!m) { error_set(err, "out of memory"); return NULL; }
     *m = (MinMaxLevels){a->key, a->base, p->size[a->base], p->num_faces, 1, NULL};
     while ((1 << (m->levels - 1)) < m->res) m->levels++;
-    m->minmax = malloc(levels_pairs(m) * 2 * sizeof *m->minmax);
+    m->minmax = bufpool_alloc(levels_pairs(m) * 2 * sizeof *m->minmax);
     if (!m->minmax) {
-        levels_destroy(m);
         error_set(err, "out of memory for the %d levels of a %d^2 multiscale (MSSM) min-max map", m->levels, m->res);
+        levels_destroy(m);
         return NULL;
     }
     size_t per_level = (size_t)m->num_faces * m->res * m->res;

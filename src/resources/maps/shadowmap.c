@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/bufpool.h"
 #include "core/hash.h"
 #include "resources/maps/logmap.h"
 #include "resources/standard.h"
@@ -35,8 +36,8 @@ size_t shadowmap_bytes_for(const Light *light, const ShadowMapSpec *spec)
 void shadowmap_free(void *r)
 {
     ShadowMap *m = r;
-    free(m->depth);
-    free(m->triangle);
+    bufpool_free(m->depth);
+    bufpool_free(m->triangle);
     free(m);
 }
 
@@ -173,8 +174,8 @@ static ShadowMap *map_alloc(const ShadowMapSpec *spec, uint64_t key, const Light
     m->res = spec->res;
     m->num_faces = m->view.num_faces;
     size_t texels = (size_t)m->num_faces * (size_t)m->res * (size_t)m->res;
-    m->depth = raster_map_alloc(texels * sizeof *m->depth);
-    if (spec->triangle_ids) m->triangle = raster_map_alloc(texels * sizeof *m->triangle);
+    m->depth = bufpool_alloc(texels * sizeof *m->depth);
+    if (spec->triangle_ids) m->triangle = bufpool_alloc(texels * sizeof *m->triangle);
     if (!m->depth || (spec->triangle_ids && !m->triangle)) {
         error_set(err, "out of memory for a %d-face %d^2 shadow map", m->num_faces, m->res);
         shadowmap_free(m);
