@@ -474,28 +474,34 @@ static inline float span_value(float f_row, float fs, float q_row, float qs, flo
     return perspective ? (f_row + fs * k) / (q_row + qs * k) : f_row + fs * k;
 }
 
+/* The nearest test over n texels of a row from d, in float lanes: texel i's
+ * value (span_value) is stored where it is nearer than d[i] and, when
+ * `edges`, the three edge values e[k] + step[k] i are all >= 0 (their
+ * bitwise or is: fill_small's per-texel test). Inlined with persp and edges
+ * constant, so every caller's loop is branch-free (a division under a branch
+ * is not if-converted) and an affine span divides nothing. */
+static inline __attribute__((always_inline)) int nearest_row(float *d, int n, float f_row, float fs, float q_row,
+                                                             float qs, bool persp, bool edges, const int32_t *e,
+                                                             const int32_t *step)
+{
+    int written = 0;
+#pragma omp simd reduction(+ : written)
+    for (int i = 0; i < n; i++) {
+        float v = span_value(f_row, fs, q_row, qs, (float)i, persp), old = d[i];
+        int pass = (!edges || ((e[0] + step[0] * i) | (e[1] + step[1] * i) | (e[2] + step[2] * i)) >= 0) && v < old;
+        d[i] = pass ? v : old;
+        written += pass;
+    }
+    return written;
+}
+
 /* The common case of a span (nearest test, no ids, peeling or clamping):
  * a branch-free loop in float lanes, AVX2 where the CPU has it. */
 __attribute__((target_clones("avx2", "default")))
 static int span_nearest(float *d, int n, float f_row, float fs, float q_row, float qs, bool persp)
 {
-    int written = 0;
-    if (persp) { /* two loops: a division under a branch is not if-converted */
-#pragma omp simd reduction(+ : written)
-        for (int i = 0; i < n; i++) {
-            float v = (f_row + fs * (float)i) / (q_row + qs * (float)i), old = d[i];
-            written += v < old;
-            d[i] = v < old ? v : old;
-        }
-        return written;
-    }
-#pragma omp simd reduction(+ : written)
-    for (int i = 0; i < n; i++) {
-        float v = f_row + fs * (float)i, old = d[i];
-        written += v < old;
-        d[i] = v < old ? v : old;
-    }
-    return written;
+    return persp ? nearest_row(d, n, f_row, fs, q_row, qs, true, false, NULL, NULL)
+                 : nearest_row(d, n, f_row, fs, q_row, qs, false, false, NULL, NULL);
 }
 
 /* A counting test's span: fragments that pass add inc to their counter,
@@ -586,29 +592,18 @@ static long fill_small(const Fill *F, const Target *T, int i0, int j0, int i1, i
     int n = i1 - i0 + 1;
     int64_t px = (int64_t)i0 * SUB + HALF;
     double fs = F->fx * SUB, qs = F->qx * SUB;
-    int32_t step0 = (int32_t)(F->a[0] * SUB), step1 = (int32_t)(F->a[1] * SUB), step2 = (int32_t)(F->a[2] * SUB);
+    const int32_t step[3] = {(int32_t)(F->a[0] * SUB), (int32_t)(F->a[1] * SUB), (int32_t)(F->a[2] * SUB)};
     bool persp = T->perspective;
     long written = 0;
     for (int j = j0; j <= j1; j++) {
         int64_t py = (int64_t)j * SUB + HALF;
-        int32_t e0 = (int32_t)(F->a[0] * px + F->b[0] * py + F->c[0]);
-        int32_t e1 = (int32_t)(F->a[1] * px + F->b[1] * py + F->c[1]);
-        int32_t e2 = (int32_t)(F->a[2] * px + F->b[2] * py + F->c[2]);
+        int32_t e[3];
+        for (int k = 0; k < 3; k++) e[k] = (int32_t)(F->a[k] * px + F->b[k] * py + F->c[k]);
         double f_row = F->f0 + F->fx * ((double)px - F->x0) + F->fy * ((double)py - F->y0);
         double q_row = F->q0 + F->qx * ((double)px - F->x0) + F->qy * ((double)py - F->y0);
         float *d = tile_row(T, j, i0);
-        /* affine values divide by 1: one branch-free loop for both kinds */
-        float fr = (float)f_row, fsf = (float)fs, qr = persp ? (float)q_row : 1.0f, qsf = persp ? (float)qs : 0.0f;
-        int w = 0;
-#pragma omp simd reduction(+ : w)
-        for (int i = 0; i < n; i++) {
-            int32_t inside = (e0 + step0 * i) | (e1 + step1 * i) | (e2 + step2 * i); /* >= 0: all three are */
-            float v = (fr + fsf * (float)i) / (qr + qsf * (float)i), old = d[i];
-            int pass = inside >= 0 && v < old;
-            d[i] = pass ? v : old;
-            w += pass;
-        }
-        written += w;
+        written += persp ? nearest_row(d, n, (float)f_row, (float)fs, (float)q_row, (float)qs, true, true, e, step)
+                         : nearest_row(d, n, (float)f_row, (float)fs, 0.0f, 0.0f, false, true, e, step);
     }
     return written;
 }
