@@ -447,7 +447,7 @@ static inline int64_t floor_div_pos(int64_t n, int64_t d)
  * integer arithmetic, so the span equals the per-texel edge tests. Only the
  * edges in the mask `edges` (bit k: edge k) are tested: the others hold over
  * the whole box the caller fills (crossing_edges). */
-static bool row_span(const Fill *F, unsigned edges, int j, int *lo, int *hi)
+static inline __attribute__((always_inline)) bool row_span(const Fill *F, unsigned edges, int j, int *lo, int *hi)
 {
     int64_t py = (int64_t)j * SUB + HALF;
     for (int k = 0; k < 3; k++) {
@@ -495,15 +495,6 @@ static inline __attribute__((always_inline)) int nearest_row(float *d, int n, fl
     return written;
 }
 
-/* The common case of a span (nearest test, no ids, peeling or clamping):
- * a branch-free loop in float lanes, AVX2 where the CPU has it. */
-__attribute__((target_clones("avx2", "default")))
-static int span_nearest(float *d, int n, float f_row, float fs, float q_row, float qs, bool persp)
-{
-    return persp ? nearest_row(d, n, f_row, fs, q_row, qs, true, false, NULL, NULL)
-                 : nearest_row(d, n, f_row, fs, q_row, qs, false, false, NULL, NULL);
-}
-
 /* A counting test's span: fragments that pass add inc to their counter,
  * unless it would leave int32 (then *overflow counts the update). */
 static long count_span(const Target *T, int32_t inc, size_t row, int n, float f_row, float fs, float q_row, float qs)
@@ -524,20 +515,37 @@ static long count_span(const Target *T, int32_t inc, size_t row, int n, float f_
     return counted;
 }
 
+/* The value and 1/w planes at the centre of texel (i, j), in double: where
+ * a row's float steps start. */
+static inline void row_planes(const Fill *F, int i, int j, double *f_row, double *q_row)
+{
+    double px = (double)i * SUB + HALF, py = (double)j * SUB + HALF;
+    *f_row = F->f0 + F->fx * (px - F->x0) + F->fy * (py - F->y0);
+    *q_row = F->q0 + F->qx * (px - F->x0) + F->qy * (py - F->y0);
+}
+
+/* The common case of a span (nearest test, no ids, peeling or clamping). */
+static inline __attribute__((always_inline)) int span_nearest(const Fill *F, const Target *T, int j, int i0, int i1)
+{
+    double f_row, q_row, fs = F->fx * SUB, qs = F->qx * SUB;
+    row_planes(F, i0, j, &f_row, &q_row);
+    float *d = tile_row(T, j, i0);
+    int n = i1 - i0 + 1;
+    return T->perspective ? nearest_row(d, n, (float)f_row, (float)fs, (float)q_row, (float)qs, true, false, NULL, NULL)
+                          : nearest_row(d, n, (float)f_row, (float)fs, 0.0f, 0.0f, false, false, NULL, NULL);
+}
+
+/* Every other span: counting tests, farthest, ids, peeling, clamping. */
 static long fill_span(const Fill *F, const Target *T, const SnapTri *t, int j, int i0, int i1)
 {
-    double py = (double)j * SUB + HALF, px0 = (double)i0 * SUB + HALF;
-    double f_row = F->f0 + F->fx * (px0 - F->x0) + F->fy * (py - F->y0);
-    double q_row = F->q0 + F->qx * (px0 - F->x0) + F->qy * (py - F->y0);
-    double fs = F->fx * SUB, qs = F->qx * SUB;
+    double f_row, q_row, fs = F->fx * SUB, qs = F->qx * SUB;
+    row_planes(F, i0, j, &f_row, &q_row);
     size_t row = (size_t)j * (size_t)T->stride + (size_t)i0;
     float *d = tile_row(T, j, i0);
     int n = i1 - i0 + 1;
     bool persp = T->perspective;
     if (T->count) return count_span(T, t->count, row, n, (float)f_row, (float)fs, (float)q_row, (float)qs);
     int32_t id = t->id;
-    if (!T->farthest && !T->id && !T->peel && !T->conservative)
-        return span_nearest(d, n, (float)f_row, (float)fs, (float)q_row, (float)qs, persp);
     long written = 0;
     for (int i = 0; i < n; i++) {
         float v = span_value((float)f_row, (float)fs, (float)q_row, (float)qs, (float)i, persp);
@@ -556,7 +564,7 @@ static long fill_span(const Fill *F, const Target *T, const SnapTri *t, int j, i
  * at a corner: an edge inside at the four corner centres is inside over
  * all of it, and row_span need not divide for it (a tile the triangle
  * covers whole, like a ground plane's at large maps, needs none). */
-static unsigned crossing_edges(const Fill *F, int i0, int j0, int i1, int j1)
+static inline __attribute__((always_inline)) unsigned crossing_edges(const Fill *F, int i0, int j0, int i1, int j1)
 {
     int64_t x0 = (int64_t)i0 * SUB + HALF, x1 = (int64_t)i1 * SUB + HALF;
     int64_t y0 = (int64_t)j0 * SUB + HALF, y1 = (int64_t)j1 * SUB + HALF;
@@ -568,15 +576,38 @@ static unsigned crossing_edges(const Fill *F, int i0, int j0, int i1, int j1)
     return edges;
 }
 
-static long fill_rect(const Fill *F, const Target *T, const SnapTri *t, int i0, int j0, int i1, int j1)
+/* The triangle's texels in the box [i0, i1] x [j0, j1], row by row, each
+ * row's exact span (row_span) drawn by span_nearest when `nearest` (inlined
+ * with it constant), else by fill_span. */
+static inline __attribute__((always_inline)) long rect_rows(const Fill *F, const Target *T, const SnapTri *t, int i0,
+                                                            int j0, int i1, int j1, bool nearest)
 {
     unsigned edges = crossing_edges(F, i0, j0, i1, j1);
     long written = 0;
     for (int j = j0; j <= j1; j++) {
         int lo = i0, hi = i1;
-        if (row_span(F, edges, j, &lo, &hi)) written += fill_span(F, T, t, j, lo, hi);
+        if (!row_span(F, edges, j, &lo, &hi)) continue;
+        written += nearest ? span_nearest(F, T, j, lo, hi) : fill_span(F, T, t, j, lo, hi);
     }
     return written;
+}
+
+/* The common case (nearest test, no ids, peeling or clamping) of a larger
+ * triangle: one call per triangle and tile, its rows' edge solves and loops
+ * inlined (AVX2 where the CPU has it) rather than a call per row (bunny
+ * 4096^2: 7.6-7.7 -> 7.1-7.3 ms, bench/README.md, step 10). row_span and
+ * crossing_edges are always inlined: called from the AVX2 clone as
+ * functions of the default ISA, they took the bunny's 4096^2 map from 7.3 to
+ * 10.3 ms. */
+__attribute__((target_clones("avx2", "default")))
+static long fill_rect_nearest(const Fill *F, const Target *T, int i0, int j0, int i1, int j1)
+{
+    return rect_rows(F, T, NULL, i0, j0, i1, j1, true);
+}
+
+static long fill_rect(const Fill *F, const Target *T, const SnapTri *t, int i0, int j0, int i1, int j1)
+{
+    return rect_rows(F, T, t, i0, j0, i1, j1, false);
 }
 
 /* The common case (nearest test, no ids, peeling or clamping) of a small
@@ -599,8 +630,8 @@ static long fill_small(const Fill *F, const Target *T, int i0, int j0, int i1, i
         int64_t py = (int64_t)j * SUB + HALF;
         int32_t e[3];
         for (int k = 0; k < 3; k++) e[k] = (int32_t)(F->a[k] * px + F->b[k] * py + F->c[k]);
-        double f_row = F->f0 + F->fx * ((double)px - F->x0) + F->fy * ((double)py - F->y0);
-        double q_row = F->q0 + F->qx * ((double)px - F->x0) + F->qy * ((double)py - F->y0);
+        double f_row, q_row;
+        row_planes(F, i0, j, &f_row, &q_row);
         float *d = tile_row(T, j, i0);
         written += persp ? nearest_row(d, n, (float)f_row, (float)fs, (float)q_row, (float)qs, true, true, e, step)
                          : nearest_row(d, n, (float)f_row, (float)fs, 0.0f, 0.0f, false, true, e, step);
@@ -688,7 +719,9 @@ static long fill_tile(const Setup *s, int tile, const SnapTri *const *bins, cons
         int i0 = t->i0 > ti0 ? t->i0 : ti0, i1 = t->i1 < ti1 ? t->i1 : ti1;
         int j0 = t->j0 > tj0 ? t->j0 : tj0, j1 = t->j1 < tj1 ? t->j1 : tj1;
         if (i0 > i1 || j0 > j1) continue;
-        written += t->small && fast ? fill_small(&F, &T, i0, j0, i1, j1) : fill_rect(&F, &T, t, i0, j0, i1, j1);
+        written += !fast       ? fill_rect(&F, &T, t, i0, j0, i1, j1)
+                   : t->small ? fill_small(&F, &T, i0, j0, i1, j1)
+                              : fill_rect_nearest(&F, &T, i0, j0, i1, j1);
     }
     if (counting) return written;
     bool quantised = opt->depth_bits == 16 || opt->depth_bits == 24;
