@@ -480,9 +480,9 @@ static inline float span_value(float f_row, float fs, float q_row, float qs, flo
  * bitwise or is: fill_small's per-texel test). Inlined with persp and edges
  * constant, so every caller's loop is branch-free (a division under a branch
  * is not if-converted) and an affine span divides nothing. */
-static inline __attribute__((always_inline)) int nearest_row(float *d, int n, float f_row, float fs, float q_row,
-                                                             float qs, bool persp, bool edges, const int32_t *e,
-                                                             const int32_t *step)
+static inline __attribute__((always_inline)) int nearest_row_of(float *d, int n, float f_row, float fs, float q_row,
+                                                                float qs, bool persp, bool edges, const int32_t *e,
+                                                                const int32_t *step)
 {
     int written = 0;
 #pragma omp simd reduction(+ : written)
@@ -493,6 +493,15 @@ static inline __attribute__((always_inline)) int nearest_row(float *d, int n, fl
         written += pass;
     }
     return written;
+}
+
+/* nearest_row_of with persp made a constant (edges stays the caller's). */
+static inline __attribute__((always_inline)) int nearest_row(float *d, int n, double f_row, double fs, double q_row,
+                                                             double qs, bool persp, bool edges, const int32_t *e,
+                                                             const int32_t *step)
+{
+    return persp ? nearest_row_of(d, n, (float)f_row, (float)fs, (float)q_row, (float)qs, true, edges, e, step)
+                 : nearest_row_of(d, n, (float)f_row, (float)fs, 0.0f, 0.0f, false, edges, e, step);
 }
 
 /* A counting test's span: fragments that pass add inc to their counter,
@@ -529,10 +538,7 @@ static inline __attribute__((always_inline)) int span_nearest(const Fill *F, con
 {
     double f_row, q_row, fs = F->fx * SUB, qs = F->qx * SUB;
     row_planes(F, i0, j, &f_row, &q_row);
-    float *d = tile_row(T, j, i0);
-    int n = i1 - i0 + 1;
-    return T->perspective ? nearest_row(d, n, (float)f_row, (float)fs, (float)q_row, (float)qs, true, false, NULL, NULL)
-                          : nearest_row(d, n, (float)f_row, (float)fs, 0.0f, 0.0f, false, false, NULL, NULL);
+    return nearest_row(tile_row(T, j, i0), i1 - i0 + 1, f_row, fs, q_row, qs, T->perspective, false, NULL, NULL);
 }
 
 /* Every other span: counting tests, farthest, ids, peeling, clamping. */
@@ -633,8 +639,7 @@ static long fill_small(const Fill *F, const Target *T, int i0, int j0, int i1, i
         double f_row, q_row;
         row_planes(F, i0, j, &f_row, &q_row);
         float *d = tile_row(T, j, i0);
-        written += persp ? nearest_row(d, n, (float)f_row, (float)fs, (float)q_row, (float)qs, true, true, e, step)
-                         : nearest_row(d, n, (float)f_row, (float)fs, 0.0f, 0.0f, false, true, e, step);
+        written += nearest_row(d, n, f_row, fs, q_row, qs, persp, true, e, step);
     }
     return written;
 }
