@@ -227,7 +227,8 @@ static double fill_timed(float *d, size_t n, bool stream)
     double t0 = timer_now_s();
 #pragma omp parallel
     {
-        size_t nt = (size_t)omp_get_num_threads(), id = (size_t)omp_get_thread_num(), line = 16;
+        size_t nt = (size_t)omp_get_num_threads(), id = (size_t)omp_get_thread_num();
+        size_t line = BUFPOOL_ALIGN / sizeof *d; /* floats per cache line */
         size_t lo = (n / line * id / nt) * line, hi = id + 1 == nt ? n : (n / line * (id + 1) / nt) * line, i = lo;
 #if defined(__SSE2__)
         if (stream) {
