@@ -207,7 +207,8 @@ static void *timed_build(ResourceManager *rm, const ResourceKind *kind, Resource
 
 /* Store a built resource; its index, or -1 with err set (and res destroyed). */
 static int store_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc, void *res,
-                       double wall_s, double own_s, const WorkCounters *own_work, Error *err)
+                       double wall_s, double own_s, int builds, double cold_own_s, const WorkCounters *own_work,
+                       Error *err)
 {
     Entry *entries = array_room(rm->entries, rm->count, &rm->cap, sizeof *entries, 16);
     if (!entries) {
@@ -217,46 +218,53 @@ static int store_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t k
     }
     rm->entries = entries;
     Entry *e = &rm->entries[rm->count];
-    *e = (Entry){kind, key, res, wall_s, own_s, kind->bytes(res), "", {NULL, 0, 0}, 1, own_s, *own_work};
+    *e = (Entry){kind, key, res, wall_s, own_s, kind->bytes(res), "", {NULL, 0, 0}, builds, cold_own_s, *own_work};
     snprintf(e->desc, sizeof e->desc, "%s", desc);
     const IntList *deps = &rm->frames[rm->depth].deps; /* the build's frame, just popped */
     for (int i = 0; i < deps->n; i++) int_list_add_unique(&e->deps, deps->v[i]);
     return rm->count++;
 }
 
-/* Builds 2 .. rm->builds of entry i (fewer past the budget), each fresh and
- * destroyed at once (the entry keeps the first); its times become the
- * medians of all of them. */
-static bool rebuild_for_median(ResourceManager *rm, int i, ResourceBuildFn build, const void *args, Error *err)
+/* Builds 2 .. rm->builds of a frame resource (fewer past the budget), each
+ * replacing the one before: that one is destroyed first, so its buffers
+ * serve the next build (core/bufpool.h) and only the first build pays its
+ * pages' first touch, as a renderer that allocates its maps once. *res is
+ * the last build (NULL with err set when one fails); *wall_s and *own_s
+ * come in as the first build's times and leave as the medians of all of
+ * them, *builds their count. Where the first takes budget_s or more, it is
+ * the only one. */
+static void rebuild_for_median(ResourceManager *rm, const ResourceKind *kind, ResourceBuildFn build, const void *args,
+                               void **res, double *wall_s, double *own_s, int *builds, Error *err)
 {
-    const ResourceKind *kind = rm->entries[i].kind;
-    double *wall_s = malloc(2 * sizeof(double) * (size_t)rm->builds), *own_s = wall_s + rm->builds;
-    if (!wall_s) return error_set(err, "out of memory timing %d builds of %s", rm->builds, kind->name);
-    wall_s[0] = rm->entries[i].build_s;
-    own_s[0] = rm->entries[i].own_s;
-    double total_s = wall_s[0];
-    int n = 1;
-    for (; n < rm->builds && (rm->budget_s <= 0 || total_s < rm->budget_s); n++) {
-        WorkCounters work; /* the first build's again: the entry keeps that */
-        void *res = timed_build(rm, kind, RES_FRAME, build, args, &wall_s[n], &own_s[n], &work, err);
-        if (!res) {
-            free(wall_s);
-            return false;
-        }
-        kind->destroy(res);
-        total_s += wall_s[n];
+    double *walls = malloc(2 * sizeof(double) * (size_t)rm->builds);
+    if (!walls) {
+        kind->destroy(*res);
+        *res = NULL;
+        error_set(err, "out of memory timing %d builds of %s", rm->builds, kind->name);
+        return;
     }
-    Entry *e = &rm->entries[i]; /* the rebuilds may have added entries and moved the table */
-    e->build_s = timer_median(wall_s, n);
-    e->own_s = timer_median(own_s, n);
-    e->builds = n;
-    free(wall_s);
-    return true;
+    double *owns = walls + rm->builds;
+    walls[0] = *wall_s;
+    owns[0] = *own_s;
+    double total_s = walls[0];
+    int n = 1;
+    for (; *res && n < rm->builds && (rm->budget_s <= 0 || total_s < rm->budget_s); n++) {
+        WorkCounters work; /* the first build's again: the entry keeps that */
+        kind->destroy(*res);
+        *res = timed_build(rm, kind, RES_FRAME, build, args, &walls[n], &owns[n], &work, err);
+        total_s += walls[n];
+    }
+    *wall_s = timer_median(walls, n);
+    *own_s = timer_median(owns, n);
+    *builds = n;
+    free(walls);
 }
 
 /* Build, time and store a new entry (a frame one inside a scope rm->builds
- * times); its index, or -1 with err set. Its whole time and work, rebuilds
- * included, are nested in the build around it and built in the scope. */
+ * times, the entry keeping the last build and the first's work and time as
+ * cold_own_s); its index, or -1 with err set. Its whole time and work,
+ * rebuilds included, are nested in the build around it and built in the
+ * scope. */
 static int build_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t key, const char *desc,
                        ResourceBuildFn build, const void *args, Error *err)
 {
@@ -265,9 +273,11 @@ static int build_entry(ResourceManager *rm, const ResourceKind *kind, uint64_t k
     work_snapshot(&w0);
     double t0 = timer_now_s(), wall_s, own_s;
     void *res = timed_build(rm, kind, category, build, args, &wall_s, &own_s, &own_work, err);
-    int i = res ? store_entry(rm, kind, key, desc, res, wall_s, own_s, &own_work, err) : -1;
-    bool repeat = i >= 0 && rm->scoping && category == RES_FRAME && rm->builds > 1;
-    if (repeat && !rebuild_for_median(rm, i, build, args, err)) i = -1; /* the entry stays: it is sound */
+    double cold_own_s = own_s;
+    int builds = 1;
+    if (res && rm->scoping && category == RES_FRAME && rm->builds > 1)
+        rebuild_for_median(rm, kind, build, args, &res, &wall_s, &own_s, &builds, err);
+    int i = res ? store_entry(rm, kind, key, desc, res, wall_s, own_s, builds, cold_own_s, &own_work, err) : -1;
     double dt = timer_now_s() - t0;
     work_snapshot(&w1);
     WorkCounters dw = work_diff(&w1, &w0);

@@ -89,7 +89,8 @@ void rm_log_note(ResourceManager *rm, const char *kind, uint64_t key, const char
  * cost of building the stage's resources from nothing, whatever an earlier
  * stage or run already built. `built` is true for builds inside the scope.
  * A frame resource built inside the scope is built `builds` times, each
- * further one a fresh build destroyed at once (the first stays cached), and
+ * further one a fresh build made after the one before is destroyed (so its
+ * buffers serve it, core/bufpool.h; the last stays cached), and
  * its build_s and own_s are their medians, so the build time a frame pays is
  * as steady as a median evaluation; builds = 1 times the one (cold) build.
  * With budget_s > 0 a resource's builds stop once they took budget_s (as
