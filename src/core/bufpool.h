@@ -11,9 +11,12 @@
  * fit without wasting more than half of themselves. Their contents are
  * whatever the last user left: callers write every byte they read.
  * Every buffer starts on a BUFPOOL_ALIGN-byte line and is a whole number of
- * lines long. Thread-safe. */
+ * lines long. A fresh buffer of at least BUFPOOL_MIN_BYTES comes with its
+ * pages in place (bufpool_populates): its first write faults no page in.
+ * Thread-safe. */
 #ifndef SL_BUFPOOL_H
 #define SL_BUFPOOL_H
+#include <stdbool.h>
 #include <stddef.h>
 
 #define BUFPOOL_ALIGN 64                        /* bytes: a cache line */
@@ -25,6 +28,10 @@
 void *bufpool_alloc(size_t bytes);
 /* p from bufpool_alloc, or NULL (nothing). */
 void bufpool_free(void *p);
+/* Whether fresh buffers of BUFPOOL_MIN_BYTES and more come populated: Linux
+ * 5.14 and later (MADV_POPULATE_WRITE), not under AddressSanitizer (whose
+ * red zones guard heap blocks only: there they come from malloc). */
+bool bufpool_populates(void);
 /* Give every kept buffer back to the system. */
 void bufpool_release(void);
 
