@@ -148,6 +148,10 @@ static void gl_matrix(const mat4 *m, float out[16])
 
 /* ---- depth maps ---------------------------------------------------------- */
 
+/* The per-round figures beside the two renders, in the order of the
+ * medians write_depth_row takes after its first three. */
+enum { ROUND_FILL, ROUND_VS_FILL, ROUND_EMPTY, ROUND_EMPTY_VS_FILL, ROUND_STORE, ROUND_STREAM, ROUND_COLUMNS };
+
 typedef struct DepthRun {
     const Casters *c;
     const GlTarget *target;
@@ -162,7 +166,7 @@ typedef struct DepthRun {
      * same size (empty: every tile stores its empty rows), over the fill;
      * round 0 is the warm-up. */
     float *fill;
-    double *fill_s, *vs_fill, *empty_s, *empty_vs_fill, *store_s, *stream_s;
+    double *per_round; /* ROUND_COLUMNS blocks of max_rounds, column c of round k at c * max_rounds + k */
     DepthBuffer empty;
     int rounds, max_rounds;
 } DepthRun;
@@ -275,37 +279,40 @@ static bool depth_round(void *run, double *gl_s, double *ours_s, Error *err)
     double fill_s = store_s < stream_s ? store_s : stream_s;
     ok = ok && raster_twice_timed(r, NULL, 0, &r->empty, &empty_s, err);
     if (r->rounds < r->max_rounds) {
-        r->store_s[r->rounds] = store_s;
-        r->stream_s[r->rounds] = stream_s;
-        r->fill_s[r->rounds] = fill_s;
-        r->vs_fill[r->rounds] = fill_s > 0.0 ? *ours_s / fill_s : INFINITY;
-        r->empty_s[r->rounds] = empty_s;
-        r->empty_vs_fill[r->rounds] = fill_s > 0.0 ? empty_s / fill_s : INFINITY;
-        r->rounds++;
+        double *col = r->per_round + r->rounds++;
+        int m = r->max_rounds;
+        col[ROUND_FILL * m] = fill_s;
+        col[ROUND_VS_FILL * m] = fill_s > 0.0 ? *ours_s / fill_s : INFINITY;
+        col[ROUND_EMPTY * m] = empty_s;
+        col[ROUND_EMPTY_VS_FILL * m] = fill_s > 0.0 ? empty_s / fill_s : INFINITY;
+        col[ROUND_STORE * m] = store_s;
+        col[ROUND_STREAM * m] = stream_s;
     }
     return ok && gl_check("the depth pass", err);
 }
 
-/* med: llvmpipe s, shadowlab s, their ratio; fill s, shadowlab / fill; no-triangle render s, it / fill; the
- * fill with ordinary and with non-temporal stores, s. */
-static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c, int res, const double med[9],
-                            const DepthAgreement *a, const char *renderer, Error *err)
+/* med: llvmpipe s, shadowlab s, their ratio, then the rounds' columns
+ * (ROUND_FILL ...) from med + 3. */
+static bool write_depth_row(const Options *o, const Scene *sc, const Casters *c, int res,
+                            const double med[3 + ROUND_COLUMNS], const DepthAgreement *a, const char *renderer,
+                            Error *err)
 {
+    const double *m = med + 3;
     char row[2048], tail[512], name[160], rend[300];
     bench_tail(tail, sizeof tail, o->c.threads);
     bench_csv_field(name, sizeof name, sc->name);
     bench_csv_field(rend, sizeof rend, renderer);
     snprintf(row, sizeof row, "%s,%ld,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%ld,%ld,%ld,%.3g,%s,%s,%s\n",
-             name, c->triangles, res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[4], med[5] * 1e3, med[6],
-             med[7] * 1e3, med[8] * 1e3, a->covered, a->coverage_mismatch,
-             a->depth_mismatch, a->max_diff, depth_agrees(a) ? "yes" : "no", rend, tail);
+             name, c->triangles, res, med[0] * 1e3, med[1] * 1e3, med[2], m[ROUND_FILL] * 1e3, m[ROUND_VS_FILL],
+             m[ROUND_EMPTY] * 1e3, m[ROUND_EMPTY_VS_FILL], m[ROUND_STORE] * 1e3, m[ROUND_STREAM] * 1e3, a->covered,
+             a->coverage_mismatch, a->depth_mismatch, a->max_diff, depth_agrees(a) ? "yes" : "no", rend, tail);
     char path[4096];
     snprintf(path, sizeof path, "%s/llvmpipe_depth.csv", o->c.dir);
     printf("  depth %5d^2: llvmpipe %8.2f ms, shadowlab %8.2f ms, speed-up %.2fx; fill %.2f ms (stores %.2f, "
            "non-temporal %.2f), shadowlab / fill %.2f, no triangles / fill %.2f; coverage off %ld, depth off %ld of %ld "
            "(max %.2g)%s\n",
-           res, med[0] * 1e3, med[1] * 1e3, med[2], med[3] * 1e3, med[7] * 1e3, med[8] * 1e3, med[4], med[6],
-           a->coverage_mismatch, a->depth_mismatch,
+           res, med[0] * 1e3, med[1] * 1e3, med[2], m[ROUND_FILL] * 1e3, m[ROUND_STORE] * 1e3,
+           m[ROUND_STREAM] * 1e3, m[ROUND_VS_FILL], m[ROUND_EMPTY_VS_FILL], a->coverage_mismatch, a->depth_mismatch,
            a->covered, a->max_diff, depth_agrees(a) ? "" : "  MISMATCH");
     return bench_csv_append(path, DEPTH_HEADER, row, err);
 }
@@ -321,21 +328,14 @@ static bool bench_depth(Lab *lab, const Casters *c, const GlContext *gl, const O
     r.target = &target;
     float *gl_depth = malloc(sizeof *gl_depth * (size_t)res * res);
     r.fill = bufpool_alloc(sizeof *r.fill * (size_t)res * res);
-    r.fill_s = malloc(sizeof *r.fill_s * (size_t)r.max_rounds);
-    r.vs_fill = malloc(sizeof *r.vs_fill * (size_t)r.max_rounds);
-    r.empty_s = malloc(sizeof *r.empty_s * (size_t)r.max_rounds);
-    r.empty_vs_fill = malloc(sizeof *r.empty_vs_fill * (size_t)r.max_rounds);
-    r.store_s = malloc(sizeof *r.store_s * (size_t)r.max_rounds);
-    r.stream_s = malloc(sizeof *r.stream_s * (size_t)r.max_rounds);
-    double med[9];
-    bool ok = (gl_depth && r.fill && r.fill_s && r.vs_fill && r.empty_s && r.empty_vs_fill && r.store_s && r.stream_s) ||
-              error_set(err, "out of memory");
+    r.per_round = malloc(sizeof *r.per_round * ROUND_COLUMNS * (size_t)r.max_rounds);
+    double med[3 + ROUND_COLUMNS];
+    bool ok = (gl_depth && r.fill && r.per_round) || error_set(err, "out of memory");
     ok = ok && depth_buffer_init(&r.db, res, res, false, err) && depth_buffer_init(&r.empty, res, res, false, err) &&
          bench_paired(depth_round, &r, o->c.repeat, med, err);
     if (ok) {
-        const double *per_round[6] = {r.fill_s, r.vs_fill, r.empty_s, r.empty_vs_fill, r.store_s, r.stream_s};
-        for (int k = 0; k < 6; k++) /* round 0: the warm-up */
-            med[3 + k] = r.rounds > 1 ? bench_median(per_round[k] + 1, r.rounds - 1) : NAN;
+        for (int c = 0; c < ROUND_COLUMNS; c++) /* round 0: the warm-up */
+            med[3 + c] = r.rounds > 1 ? bench_median(r.per_round + c * r.max_rounds + 1, r.rounds - 1) : NAN;
         glBindFramebuffer(GL_FRAMEBUFFER, target.fbo);
         glPixelStorei(GL_PACK_ALIGNMENT, 4);
         glReadPixels(0, 0, res, res, GL_DEPTH_COMPONENT, GL_FLOAT, gl_depth);
@@ -345,12 +345,7 @@ static bool bench_depth(Lab *lab, const Casters *c, const GlContext *gl, const O
     }
     free(gl_depth);
     bufpool_free(r.fill);
-    free(r.fill_s);
-    free(r.vs_fill);
-    free(r.empty_s);
-    free(r.empty_vs_fill);
-    free(r.store_s);
-    free(r.stream_s);
+    free(r.per_round);
     depth_buffer_free(&r.db);
     depth_buffer_free(&r.empty);
     gl_target_free(&target);
