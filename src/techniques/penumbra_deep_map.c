@@ -560,52 +560,99 @@ static void deep_destroy(void *res)
 
 static const ResourceKind kind_deep_map = {"penumbra_deep_map", deep_bytes, deep_destroy, RES_FRAME};
 
-/* Row buffers of the build, joined in order (thread-count independent). */
+/* Rows are built in bands of BAND_ROWS in parallel and each band appended
+ * to the map's one vertex array in row order (the map is the same for any
+ * thread count), so the vertices are held twice for one band, not for the
+ * whole map: with every row kept until the end the build's peak was 1.40x
+ * the resource's bytes (bench/README.md, step 11). */
+#define BAND_ROWS 64
+
+/* One built row's vertices, until its band is appended. */
 typedef struct Row {
     DeepVertex *vertex;
     uint32_t count;
 } Row;
 
-static bool build_rows(const DeepArgs *a, DeepMap *d, uint16_t *count, Row *row)
+/* Row r of the map into *out, from the thread's scratch and row buffer buf
+ * (room for a row at the cap); texel t's vertex count into d->first[t + 1]
+ * (build_deep_map sums them into offsets). false when out of memory. */
+static bool build_row(const DeepArgs *a, DeepMap *d, int r, Scratch *sc, DeepVertex *buf, Row *out, long *events,
+                      long *capped)
 {
-    int res = d->res, rows = d->num_faces * res;
-    long events = 0, capped = 0;
+    int res = d->res, f = r / res, j = r % res;
+    uint32_t used = 0;
+    for (int i = 0; i < res; i++) {
+        bool cap;
+        size_t t = ((size_t)f * res + j) * res + i;
+        int k = texel_function(a, f, i, j, sc, events, &cap);
+        if (k < 0) return false;
+        d->first[t + 1] = (uint32_t)k;
+        if (k == 0) {
+            d->unknown[t] = 1;
+            continue;
+        }
+        *capped += cap;
+        memcpy(buf + used, sc->out, (size_t)k * sizeof *buf);
+        used += (uint32_t)k;
+    }
+    out->count = used;
+    out->vertex = malloc((used ? used : 1) * sizeof *buf);
+    if (out->vertex) memcpy(out->vertex, buf, used * sizeof *buf);
+    return out->vertex != NULL;
+}
+
+/* Append a band's n rows to d->vertex (*total used of *cap, grown by
+ * doubling), freeing them; false when out of memory (they are freed too). */
+static bool append_band(DeepMap *d, Row *band, int n, size_t *total, size_t *cap)
+{
+    size_t need = *total;
+    for (int k = 0; k < n; k++) need += band[k].count;
     bool ok = true;
+    if (need > *cap) {
+        size_t grown = *cap > 0 ? *cap : 1024;
+        while (grown < need) grown *= 2;
+        DeepVertex *v = realloc(d->vertex, grown * sizeof *v);
+        if (v) d->vertex = v, *cap = grown;
+        ok = v != NULL;
+    }
+    for (int k = 0; k < n; k++) {
+        if (ok && band[k].vertex) memcpy(d->vertex + *total, band[k].vertex, band[k].count * sizeof *d->vertex);
+        if (ok) *total += band[k].count;
+        ok = ok && band[k].vertex;
+        free(band[k].vertex);
+        band[k] = (Row){NULL, 0};
+    }
+    return ok;
+}
+
+/* Every row, band by band; *total the vertices appended. */
+static bool build_rows(const DeepArgs *a, DeepMap *d, size_t *total)
+{
+    int rows = d->num_faces * d->res;
+    long events = 0, capped = 0;
+    size_t cap = 0;
+    bool ok = true, appended = true;
+    Row band[BAND_ROWS] = {{NULL, 0}};
+    *total = 0;
 #pragma omp parallel reduction(+ : events, capped) reduction(&& : ok)
     {
         Scratch sc = {0};
         bool grown = scratch_grow(&sc, 256);
-        DeepVertex *buf = malloc((size_t)res * (size_t)a->max_vertices * sizeof *buf);
+        DeepVertex *buf = malloc((size_t)d->res * (size_t)a->max_vertices * sizeof *buf);
         ok = grown && buf;
+        for (int r0 = 0; r0 < rows; r0 += BAND_ROWS) {
+            int n = rows - r0 < BAND_ROWS ? rows - r0 : BAND_ROWS;
 #pragma omp for schedule(dynamic, 1)
-        for (int r = 0; r < rows; r++) {
-            int f = r / res, j = r % res;
-            uint32_t used = 0;
-            for (int i = 0; ok && i < res; i++) {
-                bool cap;
-                size_t t = ((size_t)f * res + j) * res + i;
-                int k = texel_function(a, f, i, j, &sc, &events, &cap);
-                if (k < 0) ok = false;
-                if (k <= 0) {
-                    d->unknown[t] = 1, count[t] = 0;
-                    continue;
-                }
-                capped += cap;
-                memcpy(buf + used, sc.out, (size_t)k * sizeof *buf);
-                count[t] = (uint16_t)k;
-                used += (uint32_t)k;
-            }
-            row[r].count = used;
-            row[r].vertex = ok ? malloc((used ? used : 1) * sizeof *buf) : NULL;
-            if (row[r].vertex) memcpy(row[r].vertex, buf, used * sizeof *buf);
-            else ok = false;
+            for (int r = r0; r < r0 + n; r++) ok = ok && build_row(a, d, r, &sc, buf, &band[r - r0], &events, &capped);
+#pragma omp single
+            appended = append_band(d, band, n, total, &cap) && appended;
         }
         free(buf);
         free(sc.event), free(sc.zb), free(sc.c), free(sc.out);
     }
     d->events = events;
     d->capped = capped;
-    return ok;
+    return ok && appended;
 }
 
 static void *build_deep_map(const void *args, Error *err)
@@ -613,30 +660,17 @@ static void *build_deep_map(const void *args, Error *err)
     const DeepArgs *a = args;
     const ShadowMap *c = a->centre;
     DeepMap *d = calloc(1, sizeof *d);
-    size_t texels = (size_t)c->num_faces * (size_t)c->res * (size_t)c->res;
-    int rows = c->num_faces * c->res;
-    uint16_t *count = calloc(texels, sizeof *count);
-    Row *row = calloc((size_t)rows, sizeof *row);
+    size_t texels = (size_t)c->num_faces * (size_t)c->res * (size_t)c->res, total = 0;
     if (d) *d = (DeepMap){a->n, a->error, a->max_vertices, c->res, c->num_faces, texels, NULL, NULL, NULL, 0, 0};
-    bool ok = d && count && row && (d->first = malloc((texels + 1) * sizeof *d->first)) &&
-              (d->unknown = calloc(texels, 1)) && build_rows(a, d, count, row);
-    size_t total = 0;
-    for (int r = 0; ok && r < rows; r++) total += row[r].count;
-    if (ok && (d->vertex = malloc((total ? total : 1) * sizeof *d->vertex))) {
-        size_t at = 0;
-        for (int r = 0; r < rows; r++) {
-            memcpy(d->vertex + at, row[r].vertex, row[r].count * sizeof *d->vertex);
-            at += row[r].count;
-        }
-        d->first[0] = 0;
-        for (size_t t = 0; t < texels; t++) d->first[t + 1] = d->first[t] + count[t];
-    } else {
-        ok = false;
+    bool ok = d && (d->first = malloc((texels + 1) * sizeof *d->first)) && (d->unknown = calloc(texels, 1)) &&
+              build_rows(a, d, &total);
+    if (ok) {
+        d->first[0] = 0; /* the counts build_row left in first[t + 1], summed into offsets */
+        for (size_t t = 0; t < texels; t++) d->first[t + 1] += d->first[t];
+        DeepVertex *v = realloc(d->vertex, (total ? total : 1) * sizeof *v); /* the doubling's slack back */
+        if (v) d->vertex = v;
+        return d;
     }
-    for (int r = 0; row && r < rows; r++) free(row[r].vertex);
-    free(row);
-    free(count);
-    if (ok) return d;
     if (d) deep_destroy(d);
     error_set(err, "out of memory building the penumbra deep shadow map (%zu texels)", texels);
     return NULL;
