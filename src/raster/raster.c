@@ -185,11 +185,14 @@ static ClipVertex clip_vertex(const Setup *s, const Vertices *vx, uint32_t i)
 /* A block reused while large enough; its contents do not survive growth. */
 typedef struct Block { void *p; size_t bytes; } Block;
 
+/* Room for `bytes` in b, from the buffers kept between builds
+ * (core/bufpool.h): a map's faces share one scratch, and the next map's
+ * takes the same buffers back. */
 static void *block_reserve(Block *b, size_t bytes)
 {
     if (bytes <= b->bytes && b->p) return b->p;
-    free(b->p);
-    b->p = malloc(bytes > 0 ? bytes : 1);
+    bufpool_free(b->p);
+    b->p = bufpool_alloc(bytes);
     b->bytes = b->p ? bytes : 0;
     return b->p;
 }
@@ -208,7 +211,7 @@ void raster_scratch_free(RasterScratch *scratch)
     if (!scratch) return;
     Block *blocks[] = {&scratch->vertices, &scratch->tile_counts, &scratch->bin_start,
                        &scratch->cursor, &scratch->bins, &scratch->block_sum};
-    for (size_t i = 0; i < sizeof blocks / sizeof *blocks; i++) free(blocks[i]->p);
+    for (size_t i = 0; i < sizeof blocks / sizeof *blocks; i++) bufpool_free(blocks[i]->p);
     for (int k = 0; k < scratch->num_chunks; k++) {
         free(scratch->chunk[k].tri);
         free(scratch->chunk[k].box);

@@ -5,12 +5,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "core/bufpool.h"
 #include "core/hash.h"
 
 static void sw_destroy(void *r)
 {
     ShadowWidthMap *w = r;
-    free(w->width);
+    bufpool_free(w->width);
     free(w);
 }
 
@@ -122,11 +123,11 @@ static void *build_sw(const void *args, Error *err)
     int res = a->peeled->res;
     size_t texels = (size_t)res * (size_t)res, faces = (size_t)a->peeled->num_faces;
     ShadowWidthMap *w = calloc(1, sizeof *w);
-    float *scratch = a->spec.propagation == SW_SOFTWARE4 ? NULL : malloc(sizeof(float) * texels);
-    if (w) w->width = malloc(sizeof(float) * texels * faces);
+    float *scratch = a->spec.propagation == SW_SOFTWARE4 ? NULL : bufpool_alloc(sizeof(float) * texels);
+    if (w) w->width = bufpool_alloc(sizeof(float) * texels * faces); /* kept between builds (core/bufpool.h) */
     if (!w || !w->width || (a->spec.propagation != SW_SOFTWARE4 && !scratch)) {
         if (w) sw_destroy(w);
-        free(scratch);
+        bufpool_free(scratch);
         error_set(err, "out of memory for a %d^2 shadow-width map", res);
         return NULL;
     }
@@ -143,7 +144,7 @@ static void *build_sw(const void *args, Error *err)
             w->passes = propagate_doubling(face, scratch, res, a->spec.propagation == SW_DOUBLING3 ? 3 : 6,
                                            a->spec.start_difference);
     }
-    free(scratch);
+    bufpool_free(scratch);
     return w;
 }
 
