@@ -77,6 +77,10 @@
  * this long (lab.h RenderTiming; a 1024^2 cssm moment map builds in about 2 s
  * and was built 4 times a point: the growth step took 11 of QUICK's minutes). */
 #define GROWTH_QUICK_BUDGET_S 1.0
+/* The first round of timed_rounds: a configuration's repeated builds (and
+ * evaluations) stop once they took this long; a build slower than that is
+ * the one timed, cold (its pages' first touch a small part of it). */
+#define ROUNDS_BUILD_BUDGET_S 2.0
 /* --quick: the largest map growth's main parameter, triangle and image axes
  * and the threads part build (a default above it is lowered unless -p
  * map_size is given): on 1024^2 cube maps at one thread, cssm's 33-image
@@ -541,14 +545,21 @@ static double round_median(const double *t, int rounds, int n, int k)
 /* Every round times each of n configurations (labs[k], params[k]) once, in
  * order, each after measure's own untimed warm-up: frame and evaluation
  * seconds in frame[r * n + k], eval[r * n + k]; last[k] its last Point
- * (lit candidates, texel bytes per lit candidate). */
+ * (lit candidates, texel bytes per lit candidate). Round 0 builds each
+ * configuration's frame resources `rounds` times (until they took
+ * ROUNDS_BUILD_BUDGET_S) and the later rounds reuse them, so a frame's
+ * builds are the median of warm ones, as a renderer's that allocates its
+ * maps once, not the one cold build's first touch of its pages (on a
+ * virtual machine up to 5x the build: bench/README.md, step 11). */
 static bool timed_rounds(Lab *const *labs, const Technique *t, double (*params)[TECH_MAX_PARAMS], int n, int rounds,
                          double *frame, double *eval, Point *last, Error *err)
 {
     for (int r = 0; r < rounds; r++)
         for (int k = 0; k < n; k++) {
             Point *p = &last[k];
-            if (!measure(labs[k], t, params[k], 1, p, err)) return false;
+            if (!measure_within(labs[k], t, params[k], r == 0 ? rounds : 1, r == 0 ? ROUNDS_BUILD_BUDGET_S : 0.0, p,
+                                err))
+                return false;
             frame[r * n + k] = p->frame_s;
             eval[r * n + k] = p->eval_s;
         }
