@@ -41,6 +41,8 @@
  * range is the finite depths'. */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include "core/bufpool.h"
 #include "core/counters.h"
 #include "core/hash.h"
 #include "techniques/backproject.h"
@@ -157,8 +159,8 @@ static void tables_destroy(void *res)
 {
     OtTables *t = res;
     if (t) {
-        free(t->sat);
-        free(t->level);
+        bufpool_free(t->sat);
+        bufpool_free(t->level);
     }
     free(t);
 }
@@ -196,12 +198,15 @@ static int slice_of(const OtFace *f, int slices, double d)
 
 #define OT_EMPTY 255 /* a texel's slice index: no caster; `slices`: NaN */
 
-/* The SAT of the texels whose slice index is `value`. */
+/* The SAT of the texels whose slice index is `value`, its zero first row
+ * and column included (the buffer comes from bufpool, not zeroed). */
 static void build_sat(uint32_t *sat, const uint8_t *slice, int res, int value)
 {
     int n = res + 1;
+    memset(sat, 0, (size_t)n * sizeof *sat);
     for (int j = 0; j < res; j++) {
         uint32_t row = 0;
+        sat[(size_t)(j + 1) * n] = 0;
         for (int i = 0; i < res; i++) {
             row += slice[(size_t)j * res + i] == value;
             sat[(size_t)(j + 1) * n + i + 1] = sat[(size_t)j * n + i + 1] + row;
@@ -278,8 +283,11 @@ static void *build_tables(const void *args, Error *err)
     *t = *a->shape;
     t->key = a->key;
     size_t floats = tables_floats(t);
-    t->sat = calloc(tables_sats(t), sizeof *t->sat);
-    t->level = floats ? malloc(floats * sizeof *t->level) : NULL;
+    /* populated in huge pages, and kept between builds up to bufpool's limit
+     * (the cube's nbuffer levels at 1024^2 take 1.6 GB: 400k page faults a
+     * build otherwise; bench/README.md, step 11) */
+    t->sat = bufpool_alloc(tables_sats(t) * sizeof *t->sat);
+    t->level = floats ? bufpool_alloc(floats * sizeof *t->level) : NULL;
     if (!t->sat || (floats && !t->level)) {
         error_set(err, "occlusion_textures: out of memory for %.2f GiB of slice tables",
                   tables_array_bytes(t) / (1u << 30));

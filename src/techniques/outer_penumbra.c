@@ -75,6 +75,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include "core/bufpool.h"
 #include "core/counters.h"
 #include "core/hash.h"
 #include "raster/segment.h"
@@ -148,8 +149,8 @@ static void buffer_free(void *res)
 {
     OuterBuffer *b = res;
     if (!b) return;
-    free(b->value);
-    free(b->depth);
+    bufpool_free(b->value);
+    bufpool_free(b->depth);
     free(b);
 }
 
@@ -272,8 +273,8 @@ static OuterBuffer *buffer_alloc(OuterKind kind, size_t texels, Error *err)
     OuterBuffer *b = calloc(1, sizeof *b);
     if (b) {
         b->texels = texels;
-        b->value = malloc(sizeof *b->value * texels);
-        b->depth = buffer_floats(kind) == 2 ? malloc(sizeof *b->depth * texels) : NULL;
+        b->value = bufpool_alloc(sizeof *b->value * texels); /* kept between builds (core/bufpool.h) */
+        b->depth = buffer_floats(kind) == 2 ? bufpool_alloc(sizeof *b->depth * texels) : NULL;
     }
     if (!b || !b->value || (buffer_floats(kind) == 2 && !b->depth)) {
         buffer_free(b);
